@@ -1,0 +1,49 @@
+// Reading and writing triangle meshes: binary and ASCII STL, OBJ, PLY (ASCII and binary) and
+// 3MF. Readers validate everything and throw InvalidInput naming the file, the line or byte
+// offset, and what was expected; they never crash on malformed input.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "geometry.h"
+
+namespace lacuna {
+
+enum class MeshFormat { kStl, kObj, kPly, k3mf };
+
+// The format named by the file's extension (case-insensitive .stl .obj .ply .3mf); throws
+// InvalidInput for any other extension.
+MeshFormat mesh_format_from_path(const std::string& path);
+const char* mesh_format_name(MeshFormat format);
+
+struct ReadOptions {
+  // Refuse files whose declared or implied size would need more memory than this (bytes); the
+  // check happens before the large allocation. ResourceLimit is thrown beyond it.
+  uint64_t max_memory_bytes = uint64_t{8} << 30;
+};
+
+// Reads a mesh. STL vertices are welded where their float coordinates are identical (STL stores
+// no indices); OBJ polygons with more than three corners are fanned into triangles. The result
+// keeps every triangle of the file in file order. Throws IoError if the file cannot be opened,
+// InvalidInput if it is malformed, ResourceLimit if it is absurdly large.
+TriMesh read_mesh(const std::string& path, const ReadOptions& options = {});
+// The same with the format given, whatever the file's extension (used for temporary files).
+TriMesh read_mesh(const std::string& path, MeshFormat format, const ReadOptions& options = {});
+
+// Writes a binary STL (float32 coordinates, little-endian). The 80-byte header holds `header`
+// (truncated). Throws IoError on failure.
+void write_stl(const std::string& path, const TriMesh& mesh, const std::string& header);
+
+struct ThreeMfInfo {
+  std::string object_name = "part";
+  std::vector<std::pair<std::string, std::string>> metadata;  // e.g. {"Application", "Lacuna"}
+};
+
+// Writes a 3MF package (unit millimetre) with one mesh object and one build item.
+// Byte-identical output for identical input. Throws IoError on failure.
+void write_3mf(const std::string& path, const TriMesh& mesh, const ThreeMfInfo& info);
+
+}  // namespace lacuna

@@ -1,0 +1,615 @@
+// 3MF reading and writing through lib3mf 1.8's C interface.
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <new>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "Model/COM/NMR_DLLInterfaces.h"
+#include "errors.h"
+#include "export/mesh_io.h"
+
+namespace lacuna {
+namespace {
+
+using NMR::PLib3MFBase;
+
+constexpr int kMaxComponentDepth = 32;
+constexpr float kMaxCoordinateMm =
+    1e9f;  // lib3mf refuses coordinates beyond (NMR_MESH_MAXCOORDINATE)
+constexpr uint64_t kMaxIndex = 0xffffffffu;
+
+// Concatenates the arguments as an ostream would print them.
+template <typename... Args>
+std::string cat(const Args&... args) {
+  std::ostringstream out;
+  (out << ... << args);
+  return out.str();
+}
+
+// Owns one lib3mf object and releases it.
+class Handle {
+ public:
+  Handle() = default;
+  ~Handle() { reset(); }
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+
+  PLib3MFBase* get() const { return handle_; }
+  // For lib3mf's output parameters; releases what the handle held.
+  PLib3MFBase** out() {
+    reset();
+    return &handle_;
+  }
+
+ private:
+  void reset() {
+    if (handle_) NMR::lib3mf_release(handle_);
+    handle_ = nullptr;
+  }
+
+  PLib3MFBase* handle_ = nullptr;
+};
+
+// lib3mf's message for the last failure of `instance`.
+std::string last_error(PLib3MFBase* instance) {
+  DWORD code = 0;
+  const char* message = nullptr;
+  if (instance && NMR::lib3mf_getlasterror(instance, &code, &message) == LIB3MF_OK && message &&
+      *message) {
+    return cat(message, " (lib3mf error ", code, ")");
+  }
+  return "unknown lib3mf error";
+}
+
+// Throws Error with lib3mf's message if `result` reports a failure of `instance`'s method.
+template <typename Error>
+void check(int result, PLib3MFBase* instance, const std::string& context) {
+  if (result != LIB3MF_OK) throw Error(context + ": " + last_error(instance));
+}
+
+// An affine map p -> m[:, 0:3] p + m[:, 3] (lib3mf's MODELTRANSFORM layout).
+struct Affine {
+  double m[3][4] = {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}};
+
+  Vec3d operator()(const Vec3d& p) const {
+    Vec3d q;
+    for (int r = 0; r < 3; ++r) q[r] = m[r][0] * p.x + m[r][1] * p.y + m[r][2] * p.z + m[r][3];
+    return q;
+  }
+  double determinant() const {
+    return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+           m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+           m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+  }
+};
+
+Affine from_lib3mf(const NMR::MODELTRANSFORM& t) {
+  Affine a;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 4; ++c) a.m[r][c] = t.m_fFields[r][c];
+  }
+  return a;
+}
+
+// outer(inner(p)).
+Affine compose(const Affine& outer, const Affine& inner) {
+  Affine a;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 4; ++c) {
+      a.m[r][c] = outer.m[r][0] * inner.m[0][c] + outer.m[r][1] * inner.m[1][c] +
+                  outer.m[r][2] * inner.m[2][c] + (c == 3 ? outer.m[r][3] : 0);
+    }
+  }
+  return a;
+}
+
+// The length of a 3MF model unit in millimetres.
+double millimetres_per_unit(DWORD unit) {
+  switch (unit) {
+    case NMR::MODELUNIT_MICROMETER:
+      return 0.001;
+    case NMR::MODELUNIT_CENTIMETER:
+      return 10;
+    case NMR::MODELUNIT_INCH:
+      return 25.4;
+    case NMR::MODELUNIT_FOOT:
+      return 304.8;
+    case NMR::MODELUNIT_METER:
+      return 1000;
+    default:
+      return 1;
+  }
+}
+
+// The total uncompressed size of a zip archive's entries from its central directory, or -1 if
+// the directory cannot be read (lib3mf then reports what is wrong).
+double zip_uncompressed_bytes(const std::string& path) {
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"), std::fclose);
+  struct stat info;
+  if (!file || ::fstat(fileno(file.get()), &info) != 0) return -1;
+  uint64_t size = uint64_t(info.st_size);
+  std::vector<unsigned char> data;
+  auto read_at = [&](uint64_t offset, uint64_t bytes) {
+    if (offset > size || bytes > size - offset) return false;
+    data.resize(bytes);
+    return std::fseek(file.get(), long(offset), SEEK_SET) == 0 &&
+           std::fread(data.data(), 1, bytes, file.get()) == bytes;
+  };
+  auto u16 = [&](size_t at) { return uint32_t{data[at]} | uint32_t{data[at + 1]} << 8; };
+  auto u32 = [&](size_t at) { return u16(at) | u16(at + 2) << 16; };
+  auto u64 = [&](size_t at) { return uint64_t{u32(at)} | uint64_t{u32(at + 4)} << 32; };
+
+  // The end record is within the last 22 + 65535 bytes (its comment can be that long).
+  uint64_t tail = std::min<uint64_t>(size, 22 + 0xffff);
+  if (tail < 22 || !read_at(size - tail, tail)) return -1;
+  size_t end = tail - 22 + 1;
+  while (end-- > 0 && u32(end) != 0x06054b50) {
+  }
+  if (end > tail) return -1;
+  uint64_t directory_bytes = u32(end + 12), directory_offset = u32(end + 16);
+  if (directory_offset == 0xffffffff || directory_bytes == 0xffffffff) {
+    // Zip64 (lib3mf writes it): a locator just before the end record points at the zip64 end
+    // record, which holds the real values.
+    if (end < 20 || u32(end - 20) != 0x07064b50) return -1;
+    if (!read_at(u64(end - 20 + 8), 56) || u32(0) != 0x06064b50) return -1;
+    directory_bytes = u64(40);
+    directory_offset = u64(48);
+  }
+  if (!read_at(directory_offset, directory_bytes)) return -1;
+  double total = 0;
+  for (size_t entry = 0; entry + 46 <= data.size() && u32(entry) == 0x02014b50;) {
+    uint64_t unpacked = u32(entry + 24);
+    size_t extra = entry + 46 + u16(entry + 28),
+           extra_end = std::min(data.size(), extra + u16(entry + 30));
+    // A size of 0xffffffff means the 64-bit size is in the zip64 extra field (id 1), first.
+    for (size_t field = extra; unpacked == 0xffffffff && field + 4 <= extra_end;
+         field += 4 + u16(field + 2)) {
+      if (u16(field) == 1 && u16(field + 2) >= 8 && field + 12 <= extra_end) {
+        unpacked = u64(field + 4);
+      }
+    }
+    total += double(unpacked);
+    entry = extra_end + u16(entry + 32);
+  }
+  return total;
+}
+
+// Collects the triangles of a model's build items, in millimetres.
+class ModelReader {
+ public:
+  ModelReader(const std::string& path, double scale) : path_(path), scale_(scale) {}
+
+  // Vertices and triangles that appending `object` would add (memoized per resource).
+  std::pair<double, double> count(PLib3MFBase* object, int depth) {
+    DWORD id = resource_id(object);
+    if (auto found = counts_.find(id); found != counts_.end()) return found->second;
+    check_depth(depth);
+    std::pair<double, double> total{0, 0};
+    if (is_mesh(object)) {
+      DWORD vertices = 0, triangles = 0;
+      check<InvalidInput>(NMR::lib3mf_meshobject_getvertexcount(object, &vertices), object,
+                          context(id));
+      check<InvalidInput>(NMR::lib3mf_meshobject_gettrianglecount(object, &triangles), object,
+                          context(id));
+      total = {vertices, triangles};
+    } else {
+      for_each_component(object, id, [&](PLib3MFBase* child, const Affine&) {
+        auto [v, t] = count(child, depth + 1);
+        total.first += v;
+        total.second += t;
+      });
+    }
+    counts_[id] = total;
+    return total;
+  }
+
+  // Appends `object`'s triangles, placed by `transform`.
+  void append(PLib3MFBase* object, const Affine& transform, TriMesh& mesh, int depth) {
+    DWORD id = resource_id(object);
+    check_depth(depth);
+    if (!is_mesh(object)) {
+      for_each_component(object, id, [&](PLib3MFBase* child, const Affine& placement) {
+        append(child, compose(transform, placement), mesh, depth + 1);
+      });
+      return;
+    }
+    DWORD vertex_count = 0, triangle_count = 0;
+    check<InvalidInput>(NMR::lib3mf_meshobject_getvertexcount(object, &vertex_count), object,
+                        context(id));
+    check<InvalidInput>(NMR::lib3mf_meshobject_gettrianglecount(object, &triangle_count), object,
+                        context(id));
+    std::vector<NMR::MODELMESHVERTEX> vertices(vertex_count);
+    std::vector<NMR::MODELMESHTRIANGLE> triangles(triangle_count);
+    DWORD got = 0;
+    if (vertex_count > 0) {
+      check<InvalidInput>(
+          NMR::lib3mf_meshobject_getvertices(object, vertices.data(), vertex_count, &got), object,
+          context(id));
+    }
+    if (triangle_count > 0) {
+      check<InvalidInput>(
+          NMR::lib3mf_meshobject_gettriangleindices(object, triangles.data(), triangle_count, &got),
+          object, context(id));
+    }
+    uint64_t base = mesh.positions_mm.size();
+    if (base + vertex_count > kMaxIndex) {
+      throw ResourceLimit(cat(path_, ": more than ", kMaxIndex, " vertices"));
+    }
+    for (DWORD i = 0; i < vertex_count; ++i) {
+      const float* p = vertices[i].m_fPosition;
+      Vec3d position = transform(Vec3d{p[0], p[1], p[2]}) * scale_;
+      if (!is_finite(position)) {
+        throw InvalidInput(cat(context(id), ": vertex ", i, " has a non-finite coordinate"));
+      }
+      mesh.positions_mm.push_back(position);
+    }
+    // A mirroring placement turns the surface inside out; reversing the triangles restores it.
+    bool mirrored = transform.determinant() < 0;
+    for (DWORD i = 0; i < triangle_count; ++i) {
+      const DWORD* v = triangles[i].m_nIndices;
+      for (int k = 0; k < 3; ++k) {
+        if (v[k] >= vertex_count) {
+          throw InvalidInput(
+              cat(context(id), ": triangle ", i, " refers to vertex ", v[k], " of ", vertex_count));
+        }
+      }
+      uint32_t a = uint32_t(base + v[0]), b = uint32_t(base + v[1]), c = uint32_t(base + v[2]);
+      mesh.triangles.push_back(mirrored ? std::array<uint32_t, 3>{a, c, b}
+                                        : std::array<uint32_t, 3>{a, b, c});
+    }
+  }
+
+ private:
+  // "<path>: object <id>", the prefix of messages about one object.
+  std::string context(DWORD id) const { return cat(path_, ": object ", id); }
+
+  // Throws InvalidInput beyond kMaxComponentDepth (a guard against cyclic references).
+  void check_depth(int depth) const {
+    if (depth > kMaxComponentDepth) {
+      throw InvalidInput(
+          cat(path_, ": components nest more than ", kMaxComponentDepth, " levels deep"));
+    }
+  }
+
+  DWORD resource_id(PLib3MFBase* object) const {
+    DWORD id = 0;
+    check<InvalidInput>(NMR::lib3mf_resource_getresourceid(object, &id), object, path_);
+    return id;
+  }
+
+  bool is_mesh(PLib3MFBase* object) const {
+    BOOL mesh = false;
+    check<InvalidInput>(NMR::lib3mf_object_ismeshobject(object, &mesh), object, path_);
+    return mesh;
+  }
+
+  // Calls visit(child object, placement) for each component of a components object.
+  template <typename Visit>
+  void for_each_component(PLib3MFBase* object, DWORD id, Visit visit) {
+    BOOL components = false;
+    check<InvalidInput>(NMR::lib3mf_object_iscomponentsobject(object, &components), object,
+                        context(id));
+    if (!components) return;  // neither mesh nor components: nothing to build
+    DWORD n = 0;
+    check<InvalidInput>(NMR::lib3mf_componentsobject_getcomponentcount(object, &n), object,
+                        context(id));
+    for (DWORD i = 0; i < n; ++i) {
+      Handle component, child;
+      check<InvalidInput>(NMR::lib3mf_componentsobject_getcomponent(object, i, component.out()),
+                          object, context(id));
+      check<InvalidInput>(NMR::lib3mf_component_getobjectresource(component.get(), child.out()),
+                          component.get(), context(id));
+      BOOL has_transform = false;
+      NMR::MODELTRANSFORM t;
+      Affine placement;
+      check<InvalidInput>(NMR::lib3mf_component_hastransform(component.get(), &has_transform),
+                          component.get(), context(id));
+      if (has_transform) {
+        check<InvalidInput>(NMR::lib3mf_component_gettransform(component.get(), &t),
+                            component.get(), context(id));
+        placement = from_lib3mf(t);
+      }
+      visit(child.get(), placement);
+    }
+  }
+
+  const std::string& path_;
+  double scale_;  // millimetres per model unit
+  std::map<DWORD, std::pair<double, double>> counts_;
+};
+
+// FNV-1a, continued from `hash`, over raw bytes.
+uint64_t fnv1a(uint64_t hash, const void* data, size_t size) {
+  const auto* bytes = static_cast<const unsigned char*>(data);
+  for (size_t i = 0; i < size; ++i) hash = (hash ^ bytes[i]) * 0x100000001b3ull;
+  return hash;
+}
+
+// FNV-1a over a length-prefixed string (so that concatenations do not collide).
+uint64_t fnv1a(uint64_t hash, const std::string& text) {
+  uint64_t size = text.size();
+  return fnv1a(fnv1a(hash, &size, sizeof size), text.data(), text.size());
+}
+
+// The splitmix64 finalizer: spreads every input bit over the output.
+uint64_t mix(uint64_t x) {
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+  return x ^ (x >> 31);
+}
+
+// A UUID (RFC 9562 version 8, "custom") derived from a content hash and the element it names.
+std::string content_uuid(uint64_t hash, uint64_t role) {
+  uint64_t high = mix(hash + role * 0x9e3779b97f4a7c15ull);
+  uint64_t low = mix(high ^ 0x5851f42d4c957f2dull);
+  high = (high & ~uint64_t{0xf000}) | 0x8000;
+  low = (low & ~(uint64_t{3} << 62)) | uint64_t{2} << 62;
+  char text[40];
+  std::snprintf(text, sizeof text, "%08x-%04x-%04x-%04x-%012llx", unsigned(high >> 32),
+                unsigned(high >> 16 & 0xffff), unsigned(high & 0xffff), unsigned(low >> 48),
+                static_cast<unsigned long long>(low & 0xffffffffffffull));
+  return text;
+}
+
+// Where lib3mf's callback stream writes the package.
+struct MemorySink {
+  std::vector<unsigned char> bytes;
+  uint64_t position = 0;
+  bool failed = false;  // out of memory; later writes are dropped so that lib3mf unwinds cleanly
+};
+
+// lib3mf's write callback (0 means success).
+unsigned int sink_write(unsigned char* data, unsigned int size, void* user) {
+  auto* sink = static_cast<MemorySink*>(user);
+  if (sink->failed) return 0;
+  try {
+    if (sink->position + size > sink->bytes.size()) sink->bytes.resize(sink->position + size);
+  } catch (const std::bad_alloc&) {
+    sink->failed = true;
+    return 1;
+  }
+  std::memcpy(sink->bytes.data() + sink->position, data, size);
+  sink->position += size;
+  return 0;
+}
+
+// lib3mf's seek callback, to an absolute position (0 means success).
+unsigned int sink_seek(unsigned long long position, void* user) {
+  auto* sink = static_cast<MemorySink*>(user);
+  if (position > sink->bytes.size()) return 1;
+  sink->position = position;
+  return 0;
+}
+
+// lib3mf 1.8 writes metadata values into the XML without escaping them.
+std::string xml_escape(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&apos;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
+// Whether the text holds characters that XML 1.0 cannot represent.
+bool has_control_character(const std::string& text) {
+  for (unsigned char c : text) {
+    if (c < 0x20 && c != '\t' && c != '\n' && c != '\r') return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+#if defined(__SANITIZE_ADDRESS__)  // GCC
+#define LACUNA_ASAN 1
+#elif defined(__has_feature)  // clang
+#if __has_feature(address_sanitizer)
+#define LACUNA_ASAN 1
+#endif
+#endif
+#if defined(LACUNA_ASAN)
+// lib3mf 1.8 never frees libzip's per-entry sources (about 160 bytes for each part read, 56 for
+// each written); without this, every sanitizer run that touches a 3MF file fails on them.
+extern "C" const char* __lsan_default_suppressions() { return "leak:libzip.so\n"; }
+#endif
+
+TriMesh read_3mf(const std::string& path, const ReadOptions& options) {
+  // lib3mf unpacks the model before anything can be counted; the archive's directory bounds it.
+  double unpacked = zip_uncompressed_bytes(path);
+  if (unpacked > double(options.max_memory_bytes)) {
+    throw ResourceLimit(cat(path, ": the 3MF package unpacks to ", uint64_t(unpacked),
+                            " bytes (by its zip directory), more than the memory limit of ",
+                            options.max_memory_bytes, " bytes"));
+  }
+  Handle model, reader;
+  check<InvalidInput>(NMR::lib3mf_createmodel(model.out()), nullptr, path);
+  check<InvalidInput>(NMR::lib3mf_model_queryreader(model.get(), "3mf", reader.out()), model.get(),
+                      path);
+  check<InvalidInput>(NMR::lib3mf_reader_readfromfileutf8(reader.get(), path.c_str()), reader.get(),
+                      path + ": not a readable 3MF package");
+  DWORD unit = NMR::MODELUNIT_MILLIMETER;
+  check<InvalidInput>(NMR::lib3mf_model_getunit(model.get(), &unit), model.get(), path);
+  ModelReader objects(path, millimetres_per_unit(unit));
+
+  // Collect the items first so that the memory check sees the whole build.
+  std::vector<std::pair<std::unique_ptr<Handle>, Affine>> items;
+  double vertices = 0, triangles = 0;
+  Handle iterator;
+  check<InvalidInput>(NMR::lib3mf_model_getbuilditems(model.get(), iterator.out()), model.get(),
+                      path);
+  for (;;) {
+    BOOL has_next = false;
+    check<InvalidInput>(NMR::lib3mf_builditemiterator_movenext(iterator.get(), &has_next),
+                        iterator.get(), path);
+    if (!has_next) break;
+    Handle item;
+    auto object = std::make_unique<Handle>();
+    check<InvalidInput>(NMR::lib3mf_builditemiterator_getcurrent(iterator.get(), item.out()),
+                        iterator.get(), path);
+    check<InvalidInput>(NMR::lib3mf_builditem_getobjectresource(item.get(), object->out()),
+                        item.get(), path);
+    BOOL has_transform = false;
+    Affine placement;
+    check<InvalidInput>(NMR::lib3mf_builditem_hasobjecttransform(item.get(), &has_transform),
+                        item.get(), path);
+    if (has_transform) {
+      NMR::MODELTRANSFORM t;
+      check<InvalidInput>(NMR::lib3mf_builditem_getobjecttransform(item.get(), &t), item.get(),
+                          path);
+      placement = from_lib3mf(t);
+    }
+    auto [v, t] = objects.count(object->get(), 0);
+    vertices += v;
+    triangles += t;
+    items.emplace_back(std::move(object), placement);
+  }
+  // Positions and triangles, plus lib3mf's copy of the largest object while it is converted.
+  double bytes = vertices * (sizeof(Vec3d) + sizeof(NMR::MODELMESHVERTEX)) +
+                 triangles * 2 * sizeof(NMR::MODELMESHTRIANGLE);
+  if (bytes > double(options.max_memory_bytes)) {
+    throw ResourceLimit(cat(path, ": the build holds ", uint64_t(vertices), " vertices and ",
+                            uint64_t(triangles), " triangles, which need about ", uint64_t(bytes),
+                            " bytes, more than the memory limit of ", options.max_memory_bytes,
+                            " bytes"));
+  }
+  TriMesh mesh;
+  mesh.positions_mm.reserve(size_t(vertices));
+  mesh.triangles.reserve(size_t(triangles));
+  for (const auto& [object, placement] : items) objects.append(object->get(), placement, mesh, 0);
+  return mesh;
+}
+
+void write_3mf(const std::string& path, const TriMesh& mesh, const ThreeMfInfo& info) {
+  auto invalid = [&](const std::string& what) {
+    throw InvalidInput(cat("cannot write '", path, "': ", what));
+  };
+  if (mesh.positions_mm.size() > kMaxIndex || mesh.triangles.size() > kMaxIndex) {
+    throw ResourceLimit(
+        cat("cannot write '", path, "': more than ", kMaxIndex, " vertices or triangles"));
+  }
+  std::vector<NMR::MODELMESHVERTEX> vertices(mesh.positions_mm.size());
+  for (size_t i = 0; i < vertices.size(); ++i) {
+    for (int axis = 0; axis < 3; ++axis) {
+      float value = static_cast<float>(mesh.positions_mm[i][axis]);
+      if (!(std::fabs(value) <= kMaxCoordinateMm)) {
+        invalid(cat("vertex ", i, " has coordinate ", mesh.positions_mm[i][axis],
+                    "; 3MF coordinates must be finite and within 1e9 mm"));
+      }
+      vertices[i].m_fPosition[axis] = value;
+    }
+  }
+  std::vector<NMR::MODELMESHTRIANGLE> triangles(mesh.triangles.size());
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      uint32_t v = mesh.triangles[t][k];
+      if (v >= vertices.size()) {
+        invalid(cat("triangle ", t, " refers to vertex ", v, " of ", vertices.size()));
+      }
+      triangles[t].m_nIndices[k] = v;
+    }
+  }
+  // The 3MF core specification allows these names without a namespace; lib3mf 1.8 cannot declare
+  // namespaces for others.
+  static const std::set<std::string> kWellKnown = {
+      "Title",  "Designer",     "Description",      "Copyright",  "LicenseTerms",
+      "Rating", "CreationDate", "ModificationDate", "Application"};
+  std::set<std::string> seen;
+  for (const auto& [name, value] : info.metadata) {
+    if (!kWellKnown.count(name)) invalid(cat("'", name, "' is not a 3MF metadata name"));
+    if (!seen.insert(name).second) invalid(cat("metadata '", name, "' appears twice"));
+    if (has_control_character(value)) {
+      invalid(cat("metadata '", name, "' contains a control character"));
+    }
+  }
+  if (has_control_character(info.object_name)) {
+    invalid("the object name contains a control character");
+  }
+
+  // lib3mf gives every object, item and build a random UUID; deriving them from the content
+  // keeps the package byte-identical for identical input (the zip entries carry no timestamps).
+  uint64_t hash = 0xcbf29ce484222325ull;
+  hash = fnv1a(hash, vertices.data(), vertices.size() * sizeof(NMR::MODELMESHVERTEX));
+  hash = fnv1a(hash, triangles.data(), triangles.size() * sizeof(NMR::MODELMESHTRIANGLE));
+  hash = fnv1a(hash, info.object_name);
+  for (const auto& [name, value] : info.metadata) hash = fnv1a(fnv1a(hash, name), value);
+
+  const std::string where = cat("cannot write '", path, "'");
+  Handle model, object, item, writer;
+  check<IoError>(NMR::lib3mf_createmodel(model.out()), nullptr, where);
+  check<IoError>(NMR::lib3mf_model_setunit(model.get(), NMR::MODELUNIT_MILLIMETER), model.get(),
+                 where);
+  check<IoError>(NMR::lib3mf_model_addmeshobject(model.get(), object.out()), model.get(), where);
+  check<IoError>(NMR::lib3mf_object_setnameutf8(object.get(), info.object_name.c_str()),
+                 object.get(), where);
+  check<IoError>(
+      NMR::lib3mf_meshobject_setgeometry(object.get(), vertices.data(), DWORD(vertices.size()),
+                                         triangles.data(), DWORD(triangles.size())),
+      object.get(), where);
+  check<IoError>(NMR::lib3mf_object_setuuidutf8(object.get(), content_uuid(hash, 1).c_str()),
+                 object.get(), where);
+  check<IoError>(NMR::lib3mf_model_addbuilditem(model.get(), object.get(), nullptr, item.out()),
+                 model.get(), where);
+  check<IoError>(NMR::lib3mf_builditem_setuuidutf8(item.get(), content_uuid(hash, 2).c_str()),
+                 item.get(), where);
+  check<IoError>(NMR::lib3mf_model_setbuilduuidutf8(model.get(), content_uuid(hash, 3).c_str()),
+                 model.get(), where);
+  for (const auto& [name, value] : info.metadata) {
+    check<IoError>(
+        NMR::lib3mf_model_addmetadatautf8(model.get(), name.c_str(), xml_escape(value).c_str()),
+        model.get(), where);
+  }
+  check<IoError>(NMR::lib3mf_model_querywriter(model.get(), "3mf", writer.out()), model.get(),
+                 where);
+  // lib3mf 1.8 aborts the process (an exception escapes a destructor) when its own file output
+  // fails, e.g. on a full disk; so it writes into memory and the file is written here.
+  MemorySink sink;
+  int result =
+      NMR::lib3mf_writer_writetocallback(writer.get(), reinterpret_cast<void*>(&sink_write),
+                                         reinterpret_cast<void*>(&sink_seek), &sink);
+  if (sink.failed) throw ResourceLimit(where + ": out of memory for the package");
+  check<IoError>(result, writer.get(), where);
+
+  std::FILE* file = std::fopen(path.c_str(), "wb");
+  if (!file) throw IoError(cat("cannot create '", path, "': ", std::strerror(errno)));
+  bool written = std::fwrite(sink.bytes.data(), 1, sink.bytes.size(), file) == sink.bytes.size();
+  int error = errno;
+  if (std::fclose(file) != 0 && written) {
+    written = false;
+    error = errno;
+  }
+  if (!written) {
+    // Remove the partial file, unless that is no regular file (say /dev/full).
+    struct stat left;
+    if (::stat(path.c_str(), &left) == 0 && S_ISREG(left.st_mode)) std::remove(path.c_str());
+    throw IoError(where + ": " + std::strerror(error));
+  }
+}
+
+}  // namespace lacuna

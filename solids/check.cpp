@@ -1,0 +1,340 @@
+#include "solids/check.h"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
+#include <CGAL/Surface_mesh.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+#include <tbb/parallel_sort.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <numeric>
+
+#include "util/progress.h"
+
+namespace lacuna {
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Point = Kernel::Point_3;
+using SurfaceMesh = CGAL::Surface_mesh<Point>;
+
+struct HalfEdge {
+  uint64_t key;  // (min vertex << 32) | max vertex
+  uint32_t id;   // 3 * face + corner; the half-edge runs from corner to corner + 1
+  bool operator<(const HalfEdge& o) const { return key != o.key ? key < o.key : id < o.id; }
+};
+
+class DisjointSets {
+ public:
+  explicit DisjointSets(size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0u); }
+  uint32_t find(uint32_t v) {
+    while (parent_[v] != v) {
+      parent_[v] = parent_[parent_[v]];
+      v = parent_[v];
+    }
+    return v;
+  }
+  void join(uint32_t a, uint32_t b) {
+    a = find(a);
+    b = find(b);
+    if (a != b) parent_[std::max(a, b)] = std::min(a, b);
+  }
+
+ private:
+  std::vector<uint32_t> parent_;
+};
+
+// Solid angle of triangle abc seen from the origin (Van Oosterom and Strackee).
+double solid_angle(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+  double la = norm(a), lb = norm(b), lc = norm(c);
+  double num = dot(a, cross(b, c));
+  double den = la * lb * lc + dot(a, b) * lc + dot(a, c) * lb + dot(b, c) * la;
+  return 2.0 * std::atan2(num, den);
+}
+
+// CGAL's test run on slabs of the mesh in parallel: faces sorted along the longest axis, cut
+// into slabs, every face handed to each slab its box overlaps, so every pair of faces whose boxes
+// meet is tested in some slab. CGAL's own parallel mode shuffles the boxes and ran no faster than
+// one thread here.
+bool self_intersects(const TriMesh& mesh, const Box3& box, bool& built) {
+  SurfaceMesh sm;
+  sm.reserve(SurfaceMesh::size_type(mesh.positions_mm.size()), SurfaceMesh::size_type(mesh.triangles.size() * 3 / 2),
+             SurfaceMesh::size_type(mesh.triangles.size()));
+  for (const Vec3d& p : mesh.positions_mm) sm.add_vertex(Point(p.x, p.y, p.z));
+  built = true;
+  for (const auto& t : mesh.triangles) {
+    auto f = sm.add_face(SurfaceMesh::Vertex_index(t[0]), SurfaceMesh::Vertex_index(t[1]),
+                         SurfaceMesh::Vertex_index(t[2]));
+    if (f == SurfaceMesh::null_face()) {
+      built = false;
+      return false;
+    }
+  }
+  const size_t nf = mesh.triangles.size();
+  Vec3d extent = box.size();
+  int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
+  struct Span {
+    double lo, hi;
+  };
+  std::vector<Span> spans(nf);
+  std::vector<double> centres(nf);
+  for (size_t f = 0; f < nf; ++f) {
+    const auto& t = mesh.triangles[f];
+    double a = mesh.positions_mm[t[0]][axis], b = mesh.positions_mm[t[1]][axis], c = mesh.positions_mm[t[2]][axis];
+    spans[f] = {std::min({a, b, c}), std::max({a, b, c})};
+    centres[f] = (spans[f].lo + spans[f].hi) * 0.5;
+  }
+  const size_t slabs = std::clamp<size_t>(nf / 50000, 1, 64);
+  std::vector<double> cuts;  // slab j is [cuts[j], cuts[j + 1]]
+  {
+    std::vector<double> sorted = centres;
+    std::sort(sorted.begin(), sorted.end());
+    cuts.push_back(-HUGE_VAL);
+    for (size_t j = 1; j < slabs; ++j) cuts.push_back(sorted[j * nf / slabs]);
+    cuts.push_back(HUGE_VAL);
+  }
+  std::vector<std::vector<SurfaceMesh::Face_index>> members(slabs);
+  for (size_t f = 0; f < nf; ++f) {
+    size_t first = size_t(std::upper_bound(cuts.begin(), cuts.end(), spans[f].lo) - cuts.begin()) - 1;
+    for (size_t j = first; j < slabs && cuts[j] <= spans[f].hi; ++j)
+      members[j].push_back(SurfaceMesh::Face_index(uint32_t(f)));
+  }
+  std::atomic<bool> hit{false};
+  tbb::parallel_for(size_t(0), slabs, [&](size_t j) {
+    if (hit) return;
+    if (CGAL::Polygon_mesh_processing::does_self_intersect<CGAL::Sequential_tag>(members[j], sm)) hit = true;
+  });
+  return hit;
+}
+
+}  // namespace
+
+bool MeshCheckReport::valid() const {
+  return triangles > 0 && non_finite_vertices == 0 && bad_indices == 0 && degenerate_faces == 0 && closed() &&
+         manifold() && outward() && self_intersections_checked && !self_intersecting && volume_mm3 > 0;
+}
+
+std::vector<std::string> MeshCheckReport::problems() const {
+  std::vector<std::string> out;
+  auto count = [](uint64_t n, const char* what) { return std::to_string(n) + " " + what; };
+  if (triangles == 0) out.push_back("the mesh has no triangles");
+  if (non_finite_vertices) out.push_back(count(non_finite_vertices, "vertices have non-finite coordinates (NaN or infinity)"));
+  if (bad_indices) out.push_back(count(bad_indices, "triangle corners refer to vertices that do not exist"));
+  if (degenerate_faces) out.push_back(count(degenerate_faces, "degenerate faces (repeated or collinear corners)"));
+  if (boundary_edges) out.push_back(count(boundary_edges, "boundary edges: the mesh is not closed"));
+  if (non_manifold_edges) out.push_back(count(non_manifold_edges, "edges shared by more than two faces"));
+  if (misoriented_edges) out.push_back(count(misoriented_edges, "edges whose faces are oriented inconsistently"));
+  if (non_manifold_vertices) out.push_back(count(non_manifold_vertices, "non-manifold vertices (faces meeting only at a point)"));
+  if (!vertex_manifold_checked && triangles > 0 && !boundary_edges && !non_manifold_edges && !misoriented_edges)
+    out.push_back("vertex manifoldness not checked");
+  if (inward_components) out.push_back(count(inward_components, "components are oriented inward"));
+  if (self_intersecting) out.push_back("the mesh intersects itself");
+  else if (!self_intersections_checked && triangles > 0)
+    out.push_back("self-intersections not checked (the mesh is not a closed oriented manifold)");
+  if (triangles > 0 && volume_mm3 <= 0) out.push_back("the enclosed volume is not positive");
+  return out;
+}
+
+MeshCheckReport check_mesh(const TriMesh& mesh, const CheckOptions& options) {
+  MeshCheckReport r;
+  const size_t nv = mesh.positions_mm.size(), nf = mesh.triangles.size();
+  r.vertices = nv;
+  r.triangles = nf;
+  for (const Vec3d& p : mesh.positions_mm) {
+    if (!is_finite(p)) ++r.non_finite_vertices;
+    else r.bounding_box.expand(p);
+  }
+  std::vector<uint8_t> face_ok(nf, 1);
+  for (size_t f = 0; f < nf; ++f) {
+    const auto& t = mesh.triangles[f];
+    for (uint32_t v : t)
+      if (v >= nv) {
+        ++r.bad_indices;
+        face_ok[f] = 0;
+      }
+  }
+  if (nf == 0 || r.bad_indices || r.non_finite_vertices) return r;
+
+  Progress progress("check", 4);
+  // Degenerate faces: a repeated corner or three collinear corners (exact predicate).
+  r.degenerate_faces = tbb::parallel_reduce(
+      tbb::blocked_range<size_t>(0, nf, 4096), uint64_t{0},
+      [&](const tbb::blocked_range<size_t>& range, uint64_t n) {
+        for (size_t f = range.begin(); f != range.end(); ++f) {
+          const auto& t = mesh.triangles[f];
+          if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
+            ++n;
+            continue;
+          }
+          const Vec3d &a = mesh.positions_mm[t[0]], &b = mesh.positions_mm[t[1]], &c = mesh.positions_mm[t[2]];
+          if (CGAL::collinear(Point(a.x, a.y, a.z), Point(b.x, b.y, b.z), Point(c.x, c.y, c.z))) ++n;
+        }
+        return n;
+      },
+      std::plus<uint64_t>());
+  progress.advance();
+
+  // Edges: every undirected edge must have exactly two faces running it in opposite directions.
+  std::vector<HalfEdge> half_edges(3 * nf);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nf, 4096), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t f = range.begin(); f != range.end(); ++f) {
+      const auto& t = mesh.triangles[f];
+      for (int k = 0; k < 3; ++k) {
+        uint64_t a = t[k], b = t[(k + 1) % 3];
+        half_edges[3 * f + k] = HalfEdge{(std::min(a, b) << 32) | std::max(a, b), uint32_t(3 * f + k)};
+      }
+    }
+  });
+  tbb::parallel_sort(half_edges.begin(), half_edges.end());
+  std::vector<uint32_t> opposite(3 * nf, UINT32_MAX);
+  auto tail = [&](uint32_t he) { return mesh.triangles[he / 3][he % 3]; };
+  std::vector<uint64_t> edge_keys;
+  edge_keys.reserve(3 * nf / 2);
+  for (size_t i = 0; i < half_edges.size();) {
+    size_t j = i;
+    while (j < half_edges.size() && half_edges[j].key == half_edges[i].key) ++j;
+    size_t n = j - i;
+    uint64_t key = half_edges[i].key;
+    if ((key >> 32) != (key & 0xffffffffu)) {  // edges of degenerate (repeated-corner) faces aside
+      edge_keys.push_back(key);
+      if (n == 1) {
+        ++r.boundary_edges;
+      } else if (n > 2) {
+        ++r.non_manifold_edges;
+      } else {
+        uint32_t h0 = half_edges[i].id, h1 = half_edges[i + 1].id;
+        if (tail(h0) == tail(h1)) {
+          ++r.misoriented_edges;
+        } else {
+          opposite[h0] = h1;
+          opposite[h1] = h0;
+        }
+      }
+    }
+    i = j;
+  }
+  r.edges = edge_keys.size();
+  std::vector<HalfEdge>().swap(half_edges);
+  progress.advance();
+
+  // Vertex manifoldness: the faces around each vertex form one fan, closed around it.
+  const bool edges_clean = r.boundary_edges == 0 && r.non_manifold_edges == 0 && r.misoriented_edges == 0;
+  std::vector<uint32_t> degree(nv, 0), some_out(nv, UINT32_MAX);
+  for (size_t f = 0; f < nf; ++f)
+    for (int k = 0; k < 3; ++k) {
+      uint32_t v = mesh.triangles[f][k];
+      ++degree[v];
+      if (some_out[v] == UINT32_MAX) some_out[v] = uint32_t(3 * f + k);
+    }
+  if (edges_clean) {
+    r.non_manifold_vertices = tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(0, nv, 4096), uint64_t{0},
+        [&](const tbb::blocked_range<size_t>& range, uint64_t n) {
+          for (size_t v = range.begin(); v != range.end(); ++v) {
+            if (degree[v] == 0) continue;
+            uint32_t start = some_out[v], he = start, fan = 0;
+            do {
+              uint32_t prev = 3 * (he / 3) + (he % 3 + 2) % 3;  // ends at v
+              he = opposite[prev];                           // starts at v in the next face
+              ++fan;
+            } while (he != start && he != UINT32_MAX && fan <= degree[v]);
+            if (fan != degree[v]) ++n;
+          }
+          return n;
+        },
+        std::plus<uint64_t>());
+    r.vertex_manifold_checked = true;
+  }
+  progress.advance();
+
+  // Components, genus, volume and area.
+  DisjointSets sets(nv);
+  for (const auto& t : mesh.triangles) {
+    sets.join(t[0], t[1]);
+    sets.join(t[1], t[2]);
+  }
+  std::vector<uint32_t> component_of(nv, UINT32_MAX);
+  std::vector<uint32_t> root_component(nv, UINT32_MAX);
+  for (size_t v = 0; v < nv; ++v) {
+    if (degree[v] == 0) continue;
+    uint32_t root = sets.find(uint32_t(v));
+    if (root_component[root] == UINT32_MAX) root_component[root] = uint32_t(r.components++);
+    component_of[v] = root_component[root];
+  }
+  const size_t nc = r.components;
+  std::vector<int64_t> euler(nc, 0);
+  std::vector<long double> volume6(nc, 0);
+  std::vector<Box3> component_box(nc);
+  std::vector<std::vector<uint32_t>> component_faces(nc);
+  for (size_t v = 0; v < nv; ++v)
+    if (component_of[v] != UINT32_MAX) {
+      ++euler[component_of[v]];
+      component_box[component_of[v]].expand(mesh.positions_mm[v]);
+    }
+  for (uint64_t key : edge_keys) --euler[component_of[key >> 32]];
+  const Vec3d center = (r.bounding_box.min + r.bounding_box.max) * 0.5;
+  long double area2 = 0;
+  for (size_t f = 0; f < nf; ++f) {
+    const auto& t = mesh.triangles[f];
+    uint32_t c = component_of[t[0]];
+    ++euler[c];
+    if (nc > 1) component_faces[c].push_back(uint32_t(f));
+    Vec3d a = mesh.positions_mm[t[0]] - center, b = mesh.positions_mm[t[1]] - center,
+          d = mesh.positions_mm[t[2]] - center;
+    volume6[c] += dot(a, cross(b, d));
+    area2 += norm(cross(b - a, d - a));
+  }
+  long double total6 = 0;
+  for (size_t c = 0; c < nc; ++c) {
+    total6 += volume6[c];
+    r.genus += (2 - euler[c]) / 2;
+  }
+  r.volume_mm3 = double(total6 / 6.0L);
+  r.area_mm2 = double(area2 / 2.0L);
+
+  // Outward orientation: a component nested inside an odd number of others bounds a cavity and
+  // must have negative volume; every other component positive. Nesting depth from the winding
+  // number of one of its vertices with respect to each other component that could contain it.
+  if (edges_clean) {
+    r.orientation_checked = true;
+    std::vector<uint32_t> probe(nc, UINT32_MAX);
+    for (size_t v = 0; v < nv; ++v)
+      if (component_of[v] != UINT32_MAX && probe[component_of[v]] == UINT32_MAX) probe[component_of[v]] = uint32_t(v);
+    std::atomic<uint64_t> inward{0};
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, nc, 1), [&](const tbb::blocked_range<size_t>& range) {
+      for (size_t c = range.begin(); c != range.end(); ++c) {
+        const Vec3d p = mesh.positions_mm[probe[c]];
+        int depth = 0;
+        for (size_t o = 0; o < nc && nc > 1; ++o) {
+          if (o == c) continue;
+          const Box3& b = component_box[o];
+          if (p.x < b.min.x || p.y < b.min.y || p.z < b.min.z || p.x > b.max.x || p.y > b.max.y || p.z > b.max.z)
+            continue;
+          double omega = 0;
+          for (uint32_t f : component_faces[o]) {
+            const auto& t = mesh.triangles[f];
+            omega += solid_angle(mesh.positions_mm[t[0]] - p, mesh.positions_mm[t[1]] - p, mesh.positions_mm[t[2]] - p);
+          }
+          if (std::fabs(omega) > 2.0 * 3.14159265358979323846) ++depth;
+        }
+        bool should_be_positive = depth % 2 == 0;
+        if ((volume6[c] > 0) != should_be_positive) ++inward;
+      }
+    });
+    r.inward_components = inward;
+  }
+  progress.advance();
+
+  if (options.self_intersections && edges_clean && r.non_manifold_vertices == 0) {
+    bool built = false;
+    bool hit = self_intersects(mesh, r.bounding_box, built);
+    r.self_intersections_checked = built;
+    r.self_intersecting = built && hit;
+  }
+  return r;
+}
+
+}  // namespace lacuna

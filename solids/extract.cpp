@@ -1,0 +1,255 @@
+#include "solids/extract.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <openvdb/tools/Morphology.h>
+#include <openvdb/tree/LeafManager.h>
+#include <stdexcept>
+#include <unordered_map>
+
+#include "solids/vdb_internal.h"
+#include "util/progress.h"
+
+namespace lacuna {
+namespace {
+
+// Marching tetrahedra on the Freudenthal (Kuhn) split of every grid cube into six tetrahedra
+// around the main diagonal. The split is the same in every cube, so neighbouring cubes cut their
+// shared faces along the same diagonals and the tetrahedra form one consistent mesh of space.
+// The surface is the zero set of the linear interpolant on that mesh: each piece is planar
+// inside its tetrahedron, pieces meet only on shared faces along identical segments, and every
+// crossing point is shared by index. With crossings kept off the grid points no triangle is
+// degenerate and no two triangles meet except along their shared edges or vertices.
+//
+// Corner c of a cube is the offset (c & 1, (c >> 1) & 1, (c >> 2) & 1). Each tetrahedron is a
+// monotone path 0 -> e_a -> e_a + e_b -> 7; listed here in positive orientation (odd axis
+// permutations have their last two corners swapped).
+constexpr int kTets[6][4] = {{0, 1, 3, 7}, {0, 1, 7, 5}, {0, 2, 7, 3},
+                             {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 7, 6}};
+
+// Even permutations of (0, 1, 2, 3) that start with a given corner, and with a given pair.
+constexpr int kEvenFrom[4][4] = {{0, 1, 2, 3}, {1, 0, 3, 2}, {2, 3, 0, 1}, {3, 2, 1, 0}};
+int even_from_pair(int a, int b, int out[4]) {
+  static constexpr int kPairs[6][4] = {{0, 1, 2, 3}, {0, 2, 3, 1}, {0, 3, 1, 2},
+                                       {1, 2, 0, 3}, {1, 3, 2, 0}, {2, 3, 0, 1}};
+  for (const auto& p : kPairs)
+    if (p[0] == a && p[1] == b) {
+      std::copy(p, p + 4, out);
+      return 1;
+    }
+  return 0;
+}
+
+using LeafT = openvdb::FloatTree::LeafNodeType;
+using MaskLeafT = openvdb::MaskTree::LeafNodeType;
+
+uint64_t pack_origin(const openvdb::Coord& c) {
+  constexpr int64_t kBias = int64_t{1} << 20;
+  return (uint64_t((c.x() >> 3) + kBias) << 42) | (uint64_t((c.y() >> 3) + kBias) << 21) |
+         uint64_t((c.z() >> 3) + kBias);
+}
+
+struct Block {
+  openvdb::Coord origin;
+  uint32_t neighbours[8];            // block index of origin + 8 * bits(k); UINT32_MAX if none
+  std::vector<uint16_t> edge_keys;   // local voxel offset * 8 + direction, ascending
+  std::vector<Vec3d> positions;      // crossing point of each edge key, in mm
+  uint64_t first_vertex = 0;
+  std::vector<std::array<uint32_t, 3>> triangles;
+};
+
+constexpr uint32_t kNone = UINT32_MAX;
+
+// The values at origin + [0, 8]^3, x-major as in a leaf: index (x * 81 + y * 9 + z).
+void load_values(const openvdb::FloatTree& tree, openvdb::tree::ValueAccessor<const openvdb::FloatTree>& acc,
+                 const openvdb::Coord& origin, float* values) {
+  const LeafT* leaf = tree.probeConstLeaf(origin);
+  for (int x = 0; x <= 8; ++x) {
+    for (int y = 0; y <= 8; ++y) {
+      for (int z = 0; z <= 8; ++z) {
+        float v;
+        if (leaf && x < 8 && y < 8 && z < 8) v = leaf->getValue(openvdb::Index((x << 6) | (y << 3) | z));
+        else v = acc.getValue(origin.offsetBy(x, y, z));
+        values[x * 81 + y * 9 + z] = v;
+      }
+    }
+  }
+}
+
+}  // namespace
+
+uint64_t estimate_extract_bytes(const Volume& volume) {
+  // Measured: about 1.1 crossing points and 2.2 triangles per active voxel of a 3-voxel band,
+  // 24 + 12 bytes each, plus per-block bookkeeping.
+  uint64_t voxels = volume.active_voxel_count();
+  return voxels * 60 + volume.leaf_count() * 4 * 700;
+}
+
+TriMesh extract_surface(const Volume& volume, const ExtractOptions& options) {
+  TriMesh mesh;
+  if (volume.empty()) return mesh;
+  const openvdb::FloatGrid& grid = *volume.impl().grid;
+  const openvdb::FloatTree& tree = grid.tree();
+  const double h = volume.voxel_size_mm();
+  const double eps = std::clamp(options.min_edge_fraction, 1e-6, 0.25);
+
+  // Cubes to visit: those with an active corner, i.e. min corners within one voxel of the band.
+  openvdb::MaskTree mask(tree, false, openvdb::TopologyCopy());
+  mask.voxelizeActiveTiles();
+  openvdb::tools::dilateActiveValues(mask, 1, openvdb::tools::NN_FACE_EDGE_VERTEX,
+                                     openvdb::tools::IGNORE_TILES);
+  std::vector<const MaskLeafT*> mask_leaves;
+  mask_leaves.reserve(mask.leafCount());
+  for (auto it = mask.cbeginLeaf(); it; ++it) mask_leaves.push_back(it.getLeaf());
+
+  std::vector<Block> blocks(mask_leaves.size());
+  std::unordered_map<uint64_t, uint32_t> block_of;
+  block_of.reserve(blocks.size() * 2);
+  for (uint32_t i = 0; i < blocks.size(); ++i) {
+    blocks[i].origin = mask_leaves[i]->origin();
+    block_of.emplace(pack_origin(blocks[i].origin), i);
+  }
+  for (Block& b : blocks) {
+    for (int k = 0; k < 8; ++k) {
+      auto it = block_of.find(pack_origin(b.origin.offsetBy(8 * (k & 1), 8 * ((k >> 1) & 1), 8 * ((k >> 2) & 1))));
+      b.neighbours[k] = it == block_of.end() ? kNone : it->second;
+    }
+  }
+
+  Progress progress("mesh", blocks.size() * 2);
+
+  // Pass 1: crossing points on the seven edges leaving every visited voxel.
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, blocks.size(), 8), [&](const tbb::blocked_range<size_t>& r) {
+    openvdb::tree::ValueAccessor<const openvdb::FloatTree> acc(tree);
+    float values[729];
+    for (size_t bi = r.begin(); bi != r.end(); ++bi) {
+      Block& b = blocks[bi];
+      const MaskLeafT& m = *mask_leaves[bi];
+      load_values(tree, acc, b.origin, values);
+      for (auto it = m.cbeginValueOn(); it; ++it) {
+        const openvdb::Index n = it.pos();
+        const int x = int(n >> 6), y = int((n >> 3) & 7), z = int(n & 7);
+        const float f0 = values[x * 81 + y * 9 + z];
+        const bool in0 = f0 < 0;
+        for (int d = 1; d < 8; ++d) {
+          const int dx = d & 1, dy = (d >> 1) & 1, dz = (d >> 2) & 1;
+          const float f1 = values[(x + dx) * 81 + (y + dy) * 9 + (z + dz)];
+          if ((f1 < 0) == in0) continue;
+          double t = std::clamp(double(f0) / (double(f0) - double(f1)), eps, 1.0 - eps);
+          openvdb::Coord base = b.origin.offsetBy(x, y, z);
+          b.edge_keys.push_back(uint16_t(n * 8 + d));
+          b.positions.push_back(Vec3d{(base.x() + t * dx) * h, (base.y() + t * dy) * h, (base.z() + t * dz) * h});
+        }
+      }
+      progress.advance();
+    }
+  });
+
+  uint64_t vertex_count = 0;
+  for (Block& b : blocks) {
+    b.first_vertex = vertex_count;
+    vertex_count += b.positions.size();
+  }
+  if (vertex_count >= UINT32_MAX) throw std::length_error("surface has more than 4 billion vertices");
+
+  // Pass 2: the triangles of the six tetrahedra of every cube with a sign change.
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, blocks.size(), 8), [&](const tbb::blocked_range<size_t>& r) {
+    openvdb::tree::ValueAccessor<const openvdb::FloatTree> acc(tree);
+    float values[729];
+    for (size_t bi = r.begin(); bi != r.end(); ++bi) {
+      Block& b = blocks[bi];
+      const MaskLeafT& m = *mask_leaves[bi];
+      load_values(tree, acc, b.origin, values);
+      for (auto it = m.cbeginValueOn(); it; ++it) {
+        const openvdb::Index n = it.pos();
+        const int x = int(n >> 6), y = int((n >> 3) & 7), z = int(n & 7);
+        float f[8];
+        int inside = 0;
+        for (int c = 0; c < 8; ++c) {
+          f[c] = values[(x + (c & 1)) * 81 + (y + ((c >> 1) & 1)) * 9 + (z + ((c >> 2) & 1))];
+          inside |= (f[c] < 0) << c;
+        }
+        if (inside == 0 || inside == 0xff) continue;
+
+        // Vertex index of the crossing on the edge between cube corners ci and cj.
+        auto vertex = [&](int ci, int cj) -> uint32_t {
+          int lo = ci & cj, dir = ci ^ cj;  // corners of a tetrahedron are nested bit sets
+          int vx = x + (lo & 1), vy = y + ((lo >> 1) & 1), vz = z + ((lo >> 2) & 1);
+          int nb = (vx >> 3) | ((vy >> 3) << 1) | ((vz >> 3) << 2);
+          uint32_t owner = b.neighbours[nb];
+          if (owner == kNone) throw std::logic_error("surface crossing outside the narrow band");
+          const Block& ob = blocks[owner];
+          uint16_t key = uint16_t((((vx & 7) << 6) | ((vy & 7) << 3) | (vz & 7)) * 8 + dir);
+          auto pos = std::lower_bound(ob.edge_keys.begin(), ob.edge_keys.end(), key);
+          if (pos == ob.edge_keys.end() || *pos != key)
+            throw std::logic_error("surface crossing outside the narrow band");
+          return uint32_t(ob.first_vertex + uint64_t(pos - ob.edge_keys.begin()));
+        };
+
+        for (const auto& tet : kTets) {
+          int in_count = 0;
+          for (int k = 0; k < 4; ++k) in_count += (inside >> tet[k]) & 1;
+          if (in_count == 0 || in_count == 4) continue;
+          if (in_count == 1 || in_count == 3) {
+            bool want_inside = in_count == 1;
+            int lone = 0;
+            for (int k = 0; k < 4; ++k)
+              if ((((inside >> tet[k]) & 1) != 0) == want_inside) lone = k;
+            const int* p = kEvenFrom[lone];
+            uint32_t a = vertex(tet[p[0]], tet[p[1]]), bb = vertex(tet[p[0]], tet[p[2]]),
+                     c = vertex(tet[p[0]], tet[p[3]]);
+            // The triangle (a, bb, c) faces away from the lone corner; outward means away from an
+            // inside corner and towards an outside one.
+            if (want_inside) b.triangles.push_back({a, bb, c});
+            else b.triangles.push_back({a, c, bb});
+            continue;
+          }
+          int ins[2], k2 = 0;
+          for (int k = 0; k < 4; ++k)
+            if ((inside >> tet[k]) & 1) ins[k2++] = k;
+          int p[4];
+          even_from_pair(ins[0], ins[1], p);
+          // Quad (ac, ad, bd, bc) is oriented from {a, b} (inside) towards {c, d}.
+          uint32_t q[4] = {vertex(tet[p[0]], tet[p[2]]), vertex(tet[p[0]], tet[p[3]]),
+                           vertex(tet[p[1]], tet[p[3]]), vertex(tet[p[1]], tet[p[2]])};
+          // Split along the shorter diagonal, computed from the cube-local crossing positions.
+          auto local = [&](int ci, int cj) {
+            int lo = ci & cj, dir = ci ^ cj;
+            float f0 = f[lo], f1 = f[lo | dir];
+            double t = std::clamp(double(f0) / (double(f0) - double(f1)), eps, 1.0 - eps);
+            return Vec3d{(lo & 1) + t * (dir & 1), ((lo >> 1) & 1) + t * ((dir >> 1) & 1),
+                         ((lo >> 2) & 1) + t * ((dir >> 2) & 1)};
+          };
+          Vec3d l0 = local(tet[p[0]], tet[p[2]]), l1 = local(tet[p[0]], tet[p[3]]),
+                l2 = local(tet[p[1]], tet[p[3]]), l3 = local(tet[p[1]], tet[p[2]]);
+          Vec3d d02 = l2 - l0, d13 = l3 - l1;
+          if (dot(d02, d02) <= dot(d13, d13)) {
+            b.triangles.push_back({q[0], q[1], q[2]});
+            b.triangles.push_back({q[0], q[2], q[3]});
+          } else {
+            b.triangles.push_back({q[0], q[1], q[3]});
+            b.triangles.push_back({q[1], q[2], q[3]});
+          }
+        }
+      }
+      progress.advance();
+    }
+  });
+
+  uint64_t triangle_count = 0;
+  for (const Block& b : blocks) triangle_count += b.triangles.size();
+  mesh.positions_mm.reserve(vertex_count);
+  mesh.triangles.reserve(triangle_count);
+  for (Block& b : blocks) {
+    mesh.positions_mm.insert(mesh.positions_mm.end(), b.positions.begin(), b.positions.end());
+    mesh.triangles.insert(mesh.triangles.end(), b.triangles.begin(), b.triangles.end());
+    std::vector<Vec3d>().swap(b.positions);
+    std::vector<std::array<uint32_t, 3>>().swap(b.triangles);
+  }
+  return mesh;
+}
+
+}  // namespace lacuna

@@ -1,0 +1,9 @@
+// The `lacuna` command line: parses arguments and dispatches to the commands.
+#pragma once
+
+namespace lacuna {
+
+// Runs the program with the given arguments and returns its exit code (see errors.h).
+int run_app(int argc, char** argv);
+
+}  // namespace lacuna

@@ -1,0 +1,128 @@
+// The plain value types that flow between Lacuna's stages: generators produce them, solids
+// consume them. No library types appear here; all lengths are millimetres.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace lacuna {
+
+struct Vec3d {
+  double x = 0, y = 0, z = 0;
+
+  constexpr double operator[](int i) const { return i == 0 ? x : (i == 1 ? y : z); }
+  double& operator[](int i) { return i == 0 ? x : (i == 1 ? y : z); }
+  constexpr Vec3d operator+(const Vec3d& o) const { return {x + o.x, y + o.y, z + o.z}; }
+  constexpr Vec3d operator-(const Vec3d& o) const { return {x - o.x, y - o.y, z - o.z}; }
+  constexpr Vec3d operator-() const { return {-x, -y, -z}; }
+  constexpr Vec3d operator*(double s) const { return {x * s, y * s, z * s}; }
+  constexpr Vec3d operator/(double s) const { return {x / s, y / s, z / s}; }
+  Vec3d& operator+=(const Vec3d& o) { x += o.x; y += o.y; z += o.z; return *this; }
+  Vec3d& operator-=(const Vec3d& o) { x -= o.x; y -= o.y; z -= o.z; return *this; }
+  constexpr bool operator==(const Vec3d& o) const { return x == o.x && y == o.y && z == o.z; }
+  constexpr bool operator!=(const Vec3d& o) const { return !(*this == o); }
+};
+
+constexpr Vec3d operator*(double s, const Vec3d& v) { return v * s; }
+constexpr double dot(const Vec3d& a, const Vec3d& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+constexpr Vec3d cross(const Vec3d& a, const Vec3d& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+inline double norm(const Vec3d& v) { return std::sqrt(dot(v, v)); }
+inline bool is_finite(const Vec3d& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+struct Vec2d {
+  double x = 0, y = 0;
+  constexpr Vec2d operator+(const Vec2d& o) const { return {x + o.x, y + o.y}; }
+  constexpr Vec2d operator-(const Vec2d& o) const { return {x - o.x, y - o.y}; }
+  constexpr Vec2d operator*(double s) const { return {x * s, y * s}; }
+  constexpr bool operator==(const Vec2d& o) const { return x == o.x && y == o.y; }
+};
+
+// An axis-aligned box; empty when min > max on any axis.
+struct Box3 {
+  Vec3d min{HUGE_VAL, HUGE_VAL, HUGE_VAL};
+  Vec3d max{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+
+  bool empty() const { return min.x > max.x || min.y > max.y || min.z > max.z; }
+  void expand(const Vec3d& p) {
+    min = {std::fmin(min.x, p.x), std::fmin(min.y, p.y), std::fmin(min.z, p.z)};
+    max = {std::fmax(max.x, p.x), std::fmax(max.y, p.y), std::fmax(max.z, p.z)};
+  }
+  void expand(const Box3& b) {
+    if (!b.empty()) { expand(b.min); expand(b.max); }
+  }
+  Vec3d size() const { return empty() ? Vec3d{} : max - min; }
+};
+
+// An indexed triangle mesh. Closed meshes are read as solids, open ones as surfaces.
+struct TriMesh {
+  std::vector<Vec3d> positions_mm;                 // millimetres
+  std::vector<std::array<uint32_t, 3>> triangles;  // counter-clockwise seen from outside
+};
+
+// One tube: a polyline swept by a ball whose radius is given per point (round cones between
+// consecutive points, exact distance).
+struct Tube {
+  std::vector<Vec3d> points_mm;   // at least one point
+  std::vector<double> radii_mm;   // one per point, or a single value for the whole tube
+};
+
+struct TubeSet {
+  std::vector<Tube> tubes;
+};
+
+struct SphereSet {
+  std::vector<Vec3d> centers_mm;
+  std::vector<double> radii_mm;   // one per centre, or a single value for all
+};
+
+// Planar regions (polygons with holes, even-odd rule) extruded along the normal of their plane.
+// The plane is origin + u * axis_u + v * axis_v; the extrusion spans [0, height] along axis_u x axis_v.
+struct Region2 {
+  std::vector<std::vector<Vec2d>> loops_mm;  // closed loops, the last point is not repeated
+  Vec3d origin_mm{0, 0, 0};
+  Vec3d axis_u{1, 0, 0};                     // unit vectors, orthogonal
+  Vec3d axis_v{0, 1, 0};
+  double height_mm = 1.0;
+};
+
+// Analytic solids that recipes name directly; rasterized from their exact distance functions.
+struct Shape {
+  enum class Kind { kBox, kCylinder, kTorus };
+  Kind kind = Kind::kBox;
+  Vec3d center_mm;
+  Vec3d axis{0, 0, 1};       // cylinder and torus axis (unit)
+  Vec3d half_size_mm;        // box half extents
+  double radius_mm = 0;      // cylinder radius, torus major radius
+  double height_mm = 0;      // cylinder height (along axis, centred)
+  double minor_radius_mm = 0;  // torus tube radius
+};
+
+// An open (or closed) surface thickened into a shell: every point within thickness/2 of it.
+struct ThickSurface {
+  TriMesh surface;
+  double thickness_mm = 1.0;
+};
+
+// What a generator or a recipe input hands to the solid stage: a union of pieces of any kind.
+struct GeometrySet {
+  TubeSet tubes;
+  SphereSet spheres;
+  std::vector<Shape> shapes;
+  std::vector<ThickSurface> surfaces;
+  std::vector<TriMesh> solids;      // closed meshes, each bounding a solid
+  std::vector<Region2> regions;     // extruded planar regions
+};
+
+// Mesh statistics that depend only on the triangle list.
+Box3 bounding_box(const TriMesh& mesh);
+double signed_volume(const TriMesh& mesh);   // mm^3, divergence theorem, exact for closed meshes
+double surface_area(const TriMesh& mesh);    // mm^2
+
+}  // namespace lacuna

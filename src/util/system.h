@@ -1,0 +1,37 @@
+// What the process can learn about the machine and itself: memory and time.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace lacuna {
+
+// Physical memory available to this process in bytes: the machine's RAM, or the cgroup limit
+// when one is set and smaller.
+uint64_t available_memory_bytes();
+
+// Peak resident set size of this process so far, in bytes (VmHWM); 0 where unknown.
+uint64_t peak_memory_bytes();
+
+// Wall-clock seconds per named stage, in the order the stages ran.
+class StageTimer {
+ public:
+  // Starts timing `stage`; the previous stage, if any, ends now.
+  void start(const std::string& stage);
+  // Ends the current stage.
+  void stop();
+  const std::vector<std::pair<std::string, double>>& seconds() const { return seconds_; }
+
+ private:
+  std::vector<std::pair<std::string, double>> seconds_;
+  std::chrono::steady_clock::time_point started_;
+  bool running_ = false;
+};
+
+// Formats a byte count for messages, e.g. "3.2 GB".
+std::string format_bytes(uint64_t bytes);
+
+}  // namespace lacuna

@@ -1,0 +1,399 @@
+// The `lacuna` program as users run it: samples, exit codes, malformed input, memory budget,
+// determinism, and the real downstream clients (PrusaSlicer, admesh) when installed.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace lacuna {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Result {
+  int code = -1;
+  std::string out, err;
+  double seconds = 0;
+};
+
+std::string read_file(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void write_file(const fs::path& p, const std::string& text) {
+  std::ofstream out(p, std::ios::binary);
+  out << text;
+}
+
+// A fresh folder per test, removed afterwards.
+class TempDir {
+ public:
+  TempDir() {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    std::string name = "lacuna-" + std::string(info->test_suite_name()) + "-" + info->name() + "-" +
+                       std::to_string(::getpid());
+    std::replace(name.begin(), name.end(), '/', '_');
+    path_ = fs::temp_directory_path() / name;
+    fs::remove_all(path_);
+    fs::create_directories(path_);
+  }
+  ~TempDir() { fs::remove_all(path_); }
+  const fs::path& path() const { return path_; }
+  fs::path operator/(const std::string& name) const { return path_ / name; }
+
+ private:
+  fs::path path_;
+};
+
+std::string quote(const std::string& s) { return "'" + s + "'"; }
+
+Result run(const std::string& command, const fs::path& scratch) {
+  Result r;
+  fs::path out = scratch / ".stdout", err = scratch / ".stderr";
+  std::string line = command + " > " + quote(out.string()) + " 2> " + quote(err.string());
+  auto start = std::chrono::steady_clock::now();
+  int status = std::system(line.c_str());
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = read_file(out);
+  r.err = read_file(err);
+  fs::remove(out);
+  fs::remove(err);
+  return r;
+}
+
+Result lacuna(const std::string& args, const fs::path& scratch) { return run(quote(LACUNA_BINARY) + " " + args, scratch); }
+
+bool have(const char* program) {
+  std::string cmd = std::string("command -v ") + program + " > /dev/null 2>&1";
+  return std::system(cmd.c_str()) == 0;
+}
+
+std::vector<fs::path> sample_recipes() {
+  std::vector<fs::path> out;
+  for (const auto& e : fs::directory_iterator(fs::path(LACUNA_SOURCE_DIR) / "samples"))
+    if (e.path().extension() == ".json") out.push_back(e.path());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// --- every sample ------------------------------------------------------------------------------
+
+class Sample : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(Sample, RunsAndEveryOutputPassesTheChecks) {
+  TempDir dir;
+  fs::path recipe = fs::path(LACUNA_SOURCE_DIR) / "samples" / (GetParam() + ".json");
+  fs::path out = dir / "out";
+  Result r = lacuna("run " + quote(recipe.string()) + " -o " + quote(out.string()) + " --json", dir.path());
+  ASSERT_EQ(r.code, 0) << r.err;
+  nlohmann::json report = nlohmann::json::parse(r.out);
+  EXPECT_TRUE(report["valid"].get<bool>());
+  ASSERT_TRUE(fs::exists(out / "report.json"));
+  EXPECT_EQ(nlohmann::json::parse(read_file(out / "report.json"))["outputs"].size(), report["outputs"].size());
+  ASSERT_FALSE(report["outputs"].empty());
+  for (const auto& o : report["outputs"]) {
+    const std::string file = o["file"].get<std::string>();
+    ASSERT_TRUE(fs::exists(file)) << file;
+    EXPECT_TRUE(o["checks"]["valid"].get<bool>()) << file;
+    // The independent re-read through the `check` command.
+    Result c = lacuna("check --json " + quote(file), dir.path());
+    EXPECT_EQ(c.code, 0) << file << "\n" << c.out << c.err;
+    nlohmann::json cj = nlohmann::json::parse(c.out);
+    EXPECT_EQ(cj["triangles"], o["triangles"]);
+    EXPECT_EQ(cj["components"], o["components"]);
+    EXPECT_EQ(cj["genus"], o["genus"]);
+    if (have("prusa-slicer")) {
+      Result p = run("prusa-slicer --info " + quote(file), dir.path());
+      EXPECT_EQ(p.code, 0) << p.err;
+      EXPECT_NE(p.out.find("manifold = yes"), std::string::npos) << file << "\n" << p.out;
+      // PrusaSlicer prints repair counters only when it had to repair something.
+      for (const char* repaired : {"open_edges", "facets_reversed", "backwards_edges", "degenerate_facets",
+                                   "edges_fixed", "facets_removed", "facets_added"})
+        EXPECT_EQ(p.out.find(repaired), std::string::npos) << file << ": " << repaired << "\n" << p.out;
+      std::smatch m;
+      ASSERT_TRUE(std::regex_search(p.out, m, std::regex("number_of_facets = ([0-9]+)")));
+      EXPECT_EQ(std::stoull(m[1].str()), o["triangles"].get<uint64_t>());
+      ASSERT_TRUE(std::regex_search(p.out, m, std::regex("volume = ([0-9.eE+-]+)")));
+      EXPECT_NEAR(std::stod(m[1].str()), o["volume_mm3"].get<double>(), 1e-3 * o["volume_mm3"].get<double>());
+    }
+    if (have("admesh") && o["format"] == "stl") {
+      Result a = run("admesh " + quote(file), dir.path());
+      for (const char* counter : {"Degenerate facets", "Edges fixed", "Facets removed", "Facets added",
+                                  "Facets reversed", "Backwards edges", "Normals fixed"}) {
+        std::smatch m;
+        ASSERT_TRUE(std::regex_search(a.out, m, std::regex(std::string(counter) + "\\s*:\\s*([0-9]+)"))) << a.out;
+        EXPECT_EQ(m[1].str(), "0") << file << ": " << counter;
+      }
+    }
+  }
+}
+
+std::vector<std::string> sample_names() {
+  std::vector<std::string> names;
+  for (const fs::path& p : sample_recipes()) names.push_back(p.stem().string());
+  return names;
+}
+
+INSTANTIATE_TEST_SUITE_P(Samples, Sample, ::testing::ValuesIn(sample_names()),
+                         [](const ::testing::TestParamInfo<std::string>& param_info) { return param_info.param; });
+
+// --- determinism -------------------------------------------------------------------------------
+
+const char* kSmallRecipe = R"({
+  "name": "small",
+  "voxel_size_mm": 0.1,
+  "inputs": {
+    "a": {"type": "sphere", "center_mm": [0, 0, 0], "radius_mm": 2},
+    "b": {"type": "tubes", "polylines": [{"points_mm": [[0, 0, 0], [3, 1, 0], [4, 3, 1]], "radii_mm": [0.6, 0.5, 0.8]}]},
+    "hole": {"type": "cylinder", "center_mm": [0, 0, 0], "radius_mm": 0.7, "height_mm": 6}
+  },
+  "operations": [
+    {"name": "ab", "op": "union", "of": ["a", "b"]},
+    {"name": "part", "op": "difference", "of": ["ab", "hole"]}
+  ],
+  "outputs": [{"of": "part", "file": "part.stl"}, {"of": "part", "file": "part.3mf"}]
+})";
+
+TEST(Cli, SameRecipeGivesByteIdenticalFilesForAnyThreadCount) {
+  TempDir dir;
+  write_file(dir / "small.json", kSmallRecipe);
+  Result one = lacuna("run " + quote((dir / "small.json").string()) + " -o " + quote((dir / "one").string()) +
+                          " --threads 1 --quiet", dir.path());
+  Result two = lacuna("run " + quote((dir / "small.json").string()) + " -o " + quote((dir / "two").string()) +
+                          " --threads 2 --quiet", dir.path());
+  ASSERT_EQ(one.code, 0) << one.err;
+  ASSERT_EQ(two.code, 0) << two.err;
+  for (const char* name : {"part.stl", "part.3mf"}) {
+    std::string a = read_file(dir / "one" / name), b = read_file(dir / "two" / name);
+    EXPECT_GT(a.size(), 1000u);
+    EXPECT_TRUE(a == b) << name << " differs between runs";
+  }
+}
+
+TEST(Cli, HelpVersionAndUsageErrors) {
+  TempDir dir;
+  Result help = lacuna("--help", dir.path());
+  EXPECT_EQ(help.code, 0);
+  EXPECT_NE(help.out.find("run"), std::string::npos);
+  Result run_help = lacuna("run --help", dir.path());
+  EXPECT_EQ(run_help.code, 0);
+  for (const char* option : {"--voxel-size", "--max-memory", "--threads", "--quiet", "--json", "-o"})
+    EXPECT_NE(run_help.out.find(option), std::string::npos) << option;
+  EXPECT_NE(run_help.out.find("mm"), std::string::npos);
+  EXPECT_NE(run_help.out.find("GB"), std::string::npos);
+  Result version = lacuna("--version", dir.path());
+  EXPECT_EQ(version.code, 0);
+  EXPECT_NE(version.out.find("lacuna " LACUNA_VERSION), std::string::npos);
+  EXPECT_EQ(lacuna("", dir.path()).code, 2);
+  EXPECT_EQ(lacuna("frobnicate", dir.path()).code, 2);
+  EXPECT_EQ(lacuna("run", dir.path()).code, 2);
+  EXPECT_EQ(lacuna("run x.json --voxel-size -1", dir.path()).code, 2);
+  EXPECT_EQ(lacuna("run x.json --bogus", dir.path()).code, 2);
+}
+
+// --- memory budget -----------------------------------------------------------------------------
+
+TEST(Cli, RefusesBeyondTheMemoryBudgetBeforeAllocating) {
+  TempDir dir;
+  fs::path recipe = fs::path(LACUNA_SOURCE_DIR) / "samples" / "lattice_block.json";
+  Result r = lacuna("run " + quote(recipe.string()) + " -o " + quote((dir / "out").string()) + " --max-memory 0.02",
+                    dir.path());
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_NE(r.err.find("voxel size of"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+  // The suggested voxel size fits the same budget.
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.err, m, std::regex("a voxel size of ([0-9.eE+-]+) mm")));
+  Result fits = lacuna("run " + quote(recipe.string()) + " -o " + quote((dir / "out").string()) +
+                           " --max-memory 0.02 --quiet --voxel-size " + m[1].str(), dir.path());
+  EXPECT_EQ(fits.code, 0) << fits.err;
+
+  // Petabytes: refused at once, not after trying.
+  write_file(dir / "huge.json", R"({"voxel_size_mm": 0.0005,
+    "inputs": {"ball": {"type": "sphere", "radius_mm": 50}},
+    "outputs": [{"of": "ball", "file": "ball.stl"}]})");
+  Result huge = lacuna("run " + quote((dir / "huge.json").string()) + " -o " + quote((dir / "huge").string()),
+                       dir.path());
+  EXPECT_EQ(huge.code, 3) << huge.err;
+  EXPECT_LT(huge.seconds, 5.0);
+  EXPECT_FALSE(fs::exists(dir / "huge"));
+}
+
+// --- malformed input ---------------------------------------------------------------------------
+
+struct BadCase {
+  const char* name;
+  std::string recipe;       // recipe text; "@dir" in it stands for nothing special
+  std::string mesh_name;    // a mesh file written next to the recipe, when not empty
+  std::string mesh_bytes;
+  const char* expect;       // a fragment the error message must contain
+};
+
+std::string binary_stl(const std::vector<std::array<float, 9>>& tris, uint32_t declared) {
+  std::string s(80, ' ');
+  s.append(reinterpret_cast<const char*>(&declared), 4);
+  for (const auto& t : tris) {
+    float normal[3] = {0, 0, 0};
+    s.append(reinterpret_cast<const char*>(normal), 12);
+    s.append(reinterpret_cast<const char*>(t.data()), 36);
+    s.append(2, '\0');
+  }
+  return s;
+}
+
+std::vector<std::array<float, 9>> tetrahedron_triangles() {
+  const float p[4][3] = {{0, 0, 0}, {10, 0, 0}, {0, 10, 0}, {0, 0, 10}};
+  const int f[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  std::vector<std::array<float, 9>> out;
+  for (const auto& t : f) {
+    std::array<float, 9> tri;
+    for (int k = 0; k < 3; ++k)
+      for (int a = 0; a < 3; ++a) tri[3 * k + a] = p[t[k]][a];
+    out.push_back(tri);
+  }
+  return out;
+}
+
+std::string with_input(const std::string& input_json) {
+  return R"({"voxel_size_mm": 0.5, "inputs": {"x": )" + input_json + R"(}, "outputs": [{"of": "x", "file": "x.stl"}]})";
+}
+
+std::vector<BadCase> bad_cases() {
+  const std::string ok_input = R"({"type": "sphere", "radius_mm": 2})";
+  auto tets = tetrahedron_triangles();
+  auto open = tets;
+  open.pop_back();
+  auto nan = tets;
+  nan[1][4] = std::nanf("");
+  std::string truncated = binary_stl(tets, 4);
+  truncated.resize(truncated.size() - 20);
+  const std::string mesh_input = R"({"type": "mesh", "file": "hull.stl"})";
+  return {
+      {"empty_file", "", "", "", "JSON"},
+      {"not_json", "hello", "", "", "JSON"},
+      {"trailing_comma", R"({"inputs": {}, })", "", "", "JSON"},
+      {"top_level_array", "[1, 2]", "", "", "expected an object"},
+      {"misspelled_top_key", R"({"voxel_sise_mm": 0.1, "inputs": {"x": {"type": "sphere", "radius_mm": 1}}, "outputs": [{"of": "x", "file": "x.stl"}]})", "", "", "did you mean \"voxel_size_mm\""},
+      {"missing_inputs", R"({"outputs": [{"of": "x", "file": "x.stl"}]})", "", "", "inputs: missing"},
+      {"empty_inputs", R"({"inputs": {}, "outputs": [{"of": "x", "file": "x.stl"}]})", "", "", "at least one input"},
+      {"input_without_type", with_input(R"({"radius_mm": 2})"), "", "", "inputs.x.type"},
+      {"unknown_type", with_input(R"({"type": "spere", "radius_mm": 2})"), "", "", "did you mean \"sphere\""},
+      {"negative_radius", with_input(R"({"type": "sphere", "radius_mm": -2})"), "", "", "inputs.x.radius_mm"},
+      {"zero_radius", with_input(R"({"type": "sphere", "radius_mm": 0})"), "", "", "positive length"},
+      {"string_radius", with_input(R"({"type": "sphere", "radius_mm": "two"})"), "", "", "a string"},
+      {"radius_without_unit", with_input(R"({"type": "sphere", "radius": 2})"), "", "", "did you mean \"radius_mm\""},
+      {"overflowing_number", with_input(R"({"type": "sphere", "radius_mm": 1e999})"), "", "", "1e999"},
+      {"short_center", with_input(R"({"type": "sphere", "radius_mm": 2, "center_mm": [1, 2]})"), "", "", "[x, y, z]"},
+      {"negative_voxel", R"({"voxel_size_mm": -0.1, "inputs": {"x": )" + ok_input + R"(}, "outputs": [{"of": "x", "file": "x.stl"}]})", "", "", "voxel_size_mm"},
+      {"zero_voxel", R"({"voxel_size_mm": 0, "inputs": {"x": )" + ok_input + R"(}, "outputs": [{"of": "x", "file": "x.stl"}]})", "", "", "voxel_size_mm"},
+      {"thin_band", R"({"band_voxels": 1, "inputs": {"x": )" + ok_input + R"(}, "outputs": [{"of": "x", "file": "x.stl"}]})", "", "", "band_voxels"},
+      {"missing_outputs", R"({"inputs": {"x": )" + ok_input + "}}", "", "", "outputs: missing"},
+      {"empty_outputs", R"({"inputs": {"x": )" + ok_input + R"(}, "outputs": []})", "", "", "non-empty list"},
+      {"output_of_unknown", R"({"inputs": {"ball": )" + ok_input + R"(}, "outputs": [{"of": "bal", "file": "x.stl"}]})", "", "", "did you mean \"ball\""},
+      {"output_with_folder", R"({"inputs": {"x": )" + ok_input + R"(}, "outputs": [{"of": "x", "file": "../x.stl"}]})", "", "", "plain file name"},
+      {"output_bad_extension", R"({"inputs": {"x": )" + ok_input + R"(}, "outputs": [{"of": "x", "file": "x.obj"}]})", "", "", ".stl or .3mf"},
+      {"output_twice", R"({"inputs": {"x": )" + ok_input + R"(}, "outputs": [{"of": "x", "file": "x.stl"}, {"of": "x", "file": "x.stl"}]})", "", "", "written twice"},
+      {"operation_unknown_operand", R"({"inputs": {"x": )" + ok_input + R"(}, "operations": [{"name": "u", "op": "union", "of": ["x", "y"]}], "outputs": [{"of": "u", "file": "x.stl"}]})", "", "", "operations[0].of"},
+      {"operation_forward_reference", R"({"inputs": {"x": )" + ok_input + R"(}, "operations": [{"name": "u", "op": "union", "of": ["x", "v"]}, {"name": "v", "op": "offset", "of": "x", "distance_mm": 1}], "outputs": [{"of": "u", "file": "x.stl"}]})", "", "", "earlier operation"},
+      {"operation_duplicate_name", R"({"inputs": {"x": )" + ok_input + R"(}, "operations": [{"name": "x", "op": "offset", "of": "x", "distance_mm": 1}], "outputs": [{"of": "x", "file": "x.stl"}]})", "", "", "already the name"},
+      {"operation_misspelled", R"({"inputs": {"x": )" + ok_input + R"(, "y": )" + ok_input + R"(}, "operations": [{"name": "u", "op": "unoin", "of": ["x", "y"]}], "outputs": [{"of": "u", "file": "x.stl"}]})", "", "", "did you mean \"union\""},
+      {"offset_zero", R"({"inputs": {"x": )" + ok_input + R"(}, "operations": [{"name": "u", "op": "offset", "of": "x", "distance_mm": 0}], "outputs": [{"of": "u", "file": "x.stl"}]})", "", "", "non-zero"},
+      {"shell_negative", R"({"inputs": {"x": )" + ok_input + R"(}, "operations": [{"name": "u", "op": "shell", "of": "x", "thickness_mm": -1}], "outputs": [{"of": "u", "file": "x.stl"}]})", "", "", "thickness_mm"},
+      {"union_of_one", R"({"inputs": {"x": )" + ok_input + R"(}, "operations": [{"name": "u", "op": "union", "of": ["x"]}], "outputs": [{"of": "u", "file": "x.stl"}]})", "", "", "at least two"},
+      {"duplicate_key", R"({"inputs": {"x": {"type": "sphere", "radius_mm": 1, "radius_mm": 2}}, "outputs": [{"of": "x", "file": "x.stl"}]})", "", "", "appears twice"},
+      {"radii_count_mismatch", with_input(R"({"type": "tubes", "polylines": [{"points_mm": [[0,0,0],[1,0,0],[2,0,0]], "radii_mm": [0.5, 0.5]}]})"), "", "", "one radius per point"},
+      {"tube_without_points", with_input(R"({"type": "tubes", "polylines": [{"points_mm": [], "radius_mm": 0.5}]})"), "", "", "at least one point"},
+      {"box_inverted", with_input(R"({"type": "box", "min_mm": [0,0,0], "max_mm": [1,-1,1]})"), "", "", "max_mm > min_mm"},
+      {"torus_fat", with_input(R"({"type": "torus", "major_radius_mm": 2, "minor_radius_mm": 3})"), "", "", "minor_radius_mm"},
+      {"mesh_file_missing", with_input(R"({"type": "mesh", "file": "nowhere.stl"})"), "", "", "does not exist"},
+      {"mesh_truncated_stl", with_input(mesh_input), "hull.stl", truncated, "hull.stl"},
+      {"mesh_open", with_input(mesh_input), "hull.stl", binary_stl(open, 3), "not a closed mesh"},
+      {"mesh_nan", with_input(mesh_input), "hull.stl", binary_stl(nan, 4), "hull.stl"},
+      {"mesh_obj_bad_index", with_input(R"({"type": "mesh", "file": "hull.obj"})"), "hull.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n", "hull.obj"},
+      {"mesh_absurd_ply", with_input(R"({"type": "mesh", "file": "hull.ply"})"), "hull.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n", "hull.ply"},
+      {"inline_bad_index", with_input(R"({"type": "mesh", "positions_mm": [[0,0,0],[1,0,0],[0,1,0]], "triangles": [[0, 1, 3]]})"), "", "", "triangles[0]"},
+      {"surface_without_thickness", with_input(R"({"type": "surface", "positions_mm": [[0,0,0],[1,0,0],[0,1,0]], "triangles": [[0, 1, 2]]})"), "", "", "thickness_mm"},
+      {"region_short_loop", with_input(R"({"type": "region", "loops_mm": [[[0,0],[1,0]]], "height_mm": 1})"), "", "", "at least 3 points"},
+      {"region_bow_tie", with_input(R"({"type": "region", "loops_mm": [[[0,0],[4,4],[4,0],[0,4]]], "height_mm": 1})"), "", "", "cross"},
+      {"future_format", R"({"lacuna_recipe": 2, "inputs": {"x": )" + ok_input + R"(}, "outputs": [{"of": "x", "file": "x.stl"}]})", "", "", "format 1"},
+      {"bad_name", R"({"inputs": {"a b": )" + ok_input + R"(}, "outputs": [{"of": "a b", "file": "x.stl"}]})", "", "", "names use"},
+      {"negative_seed", R"({"seed": -3, "inputs": {"x": )" + ok_input + R"(}, "outputs": [{"of": "x", "file": "x.stl"}]})", "", "", "seed"},
+      {"empty_result", R"({"inputs": {"a": {"type": "sphere", "radius_mm": 1}, "b": {"type": "sphere", "center_mm": [9, 0, 0], "radius_mm": 1}}, "operations": [{"name": "i", "op": "intersection", "of": ["a", "b"]}], "outputs": [{"of": "i", "file": "x.stl"}]})", "", "", "empty"},
+  };
+}
+
+TEST(Cli, MalformedInputIsRejectedWithExitTwoAndNothingWritten) {
+  std::vector<BadCase> cases = bad_cases();
+  ASSERT_GE(cases.size(), 30u);
+  for (const BadCase& c : cases) {
+    TempDir dir;
+    fs::path recipe = dir / (std::string(c.name) + ".json");
+    write_file(recipe, c.recipe);
+    if (!c.mesh_name.empty()) write_file(dir / c.mesh_name, c.mesh_bytes);
+    const size_t files_before = std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator());
+    Result r = lacuna("run " + quote(recipe.string()) + " -o " + quote((dir / "out").string()), dir.path());
+    EXPECT_EQ(r.code, 2) << c.name << ": " << r.err;
+    EXPECT_NE(r.err.find(c.name), std::string::npos) << c.name << ": the message should name the file: " << r.err;
+    EXPECT_NE(r.err.find(c.expect), std::string::npos) << c.name << ": expected \"" << c.expect << "\" in: " << r.err;
+    EXPECT_FALSE(fs::exists(dir / "out")) << c.name;
+    EXPECT_EQ(size_t(std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator())), files_before) << c.name;
+  }
+  TempDir dir;
+  Result missing = lacuna("run " + quote((dir / "missing.json").string()), dir.path());
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_NE(missing.err.find("missing.json"), std::string::npos);
+  Result folder = lacuna("run " + quote(dir.path().string()), dir.path());
+  EXPECT_EQ(folder.code, 2);
+  EXPECT_NE(folder.err.find("folder"), std::string::npos);
+}
+
+// --- check -------------------------------------------------------------------------------------
+
+TEST(Cli, CheckAcceptsValidAndRejectsBrokenMeshes) {
+  TempDir dir;
+  write_file(dir / "tet.stl", binary_stl(tetrahedron_triangles(), 4));
+  Result ok = lacuna("check --json " + quote((dir / "tet.stl").string()), dir.path());
+  EXPECT_EQ(ok.code, 0) << ok.out << ok.err;
+  nlohmann::json j = nlohmann::json::parse(ok.out);
+  EXPECT_NEAR(j["volume_mm3"].get<double>(), 1000.0 / 6.0, 1e-9);
+  EXPECT_TRUE(j["checks"]["valid"].get<bool>());
+
+  auto open = tetrahedron_triangles();
+  open.pop_back();
+  write_file(dir / "open.stl", binary_stl(open, 3));
+  Result bad = lacuna("check " + quote((dir / "open.stl").string()), dir.path());
+  EXPECT_EQ(bad.code, 4);
+  EXPECT_NE(bad.out.find("boundary edges"), std::string::npos) << bad.out;
+
+  auto inverted = tetrahedron_triangles();
+  for (auto& t : inverted) {
+    for (int a = 0; a < 3; ++a) std::swap(t[3 + a], t[6 + a]);
+  }
+  write_file(dir / "inverted.stl", binary_stl(inverted, 4));
+  Result inv = lacuna("check --json " + quote((dir / "inverted.stl").string()), dir.path());
+  EXPECT_EQ(inv.code, 4);
+  EXPECT_FALSE(nlohmann::json::parse(inv.out)["checks"]["outward_oriented"].get<bool>());
+
+  write_file(dir / "garbage.stl", "solid x\nfacet normal 0 0 0\n outer loop\n vertex 1 2\n");
+  Result garbage = lacuna("check " + quote((dir / "garbage.stl").string()), dir.path());
+  EXPECT_EQ(garbage.code, 2);
+  EXPECT_NE(garbage.err.find("garbage.stl"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace lacuna
