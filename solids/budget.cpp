@@ -8,48 +8,57 @@
 namespace lacuna {
 namespace {
 
-// Measured on spheres, tori, capsule chains and plates (see the budget test):
-constexpr double kTrianglesPerVoxelFace = 9.5;   // marching tetrahedra: triangles per (area / h^2)
-constexpr double kLeafBytesPerVoxelFace = 64.0;  // grid leaves (8^3 x 4 B, partly filled) per (area / h^2)
-constexpr double kMeshBytesPerTriangle = 420.0;  // extraction + STL/3MF re-read + CGAL checks, peak
-constexpr double kPairBytes = 16.0;              // one (leaf, primitive) pair while rasterizing
+// Measured (README, "Memory model"): marching tetrahedra give 1.5-1.6 triangles per active voxel
+// of a 3-voxel band; the leaves hold about 11 bytes per active voxel; extracting, re-reading and
+// checking (CGAL surface mesh and box tree) peak at about 160 bytes per triangle.
+constexpr double kTrianglesPerActiveVoxel = 1.6;
+constexpr double kGridBytesPerActiveVoxel = 12.0;
+constexpr double kMeshBytesPerTriangle = 180.0;
+constexpr double kPairBytes = 16.0;  // one (leaf, primitive) pair while rasterizing
 
-double voxel_faces(double area_mm2, double h) { return area_mm2 / (h * h); }
+uint64_t saturate(double v) { return v >= 1.8e19 ? uint64_t(1.8e19) : uint64_t(std::max(v, 0.0)); }
 
 }  // namespace
 
-uint64_t estimate_mesh_bytes(uint64_t triangles) { return uint64_t(double(triangles) * kMeshBytesPerTriangle); }
-
-MemoryEstimate estimate_from_area(double surface_area_mm2, const VolumeOptions& options) {
-  MemoryEstimate e;
+uint64_t band_voxels(double surface_area_mm2, const Box3& box, const VolumeOptions& options) {
   const double h = options.voxel_size_mm;
-  const double faces = voxel_faces(surface_area_mm2, h);
-  e.surface_area_mm2 = surface_area_mm2;
-  e.active_voxels = uint64_t(std::min(faces * 2.0 * options.half_band_voxels, 1e19));
-  e.triangles = uint64_t(std::min(faces * kTrianglesPerVoxelFace, 1e19));
-  e.grid_bytes = uint64_t(std::min(faces * kLeafBytesPerVoxelFace * options.half_band_voxels / 3.0, 1e19));
-  e.mesh_bytes = uint64_t(std::min(double(e.triangles) * kMeshBytesPerTriangle, 1e19));
+  double from_area = surface_area_mm2 / (h * h) * 2.0 * options.half_band_voxels;
+  if (box.empty()) return saturate(from_area);
+  const double pad = 2 * h * options.half_band_voxels;
+  Vec3d size = box.size();
+  double from_box = (size.x + pad) / h * ((size.y + pad) / h) * ((size.z + pad) / h);
+  return saturate(std::min(from_area, from_box));
+}
+
+MemoryEstimate estimate_from_voxels(uint64_t active_voxels, const VolumeOptions& options) {
+  (void)options;
+  MemoryEstimate e;
+  e.active_voxels = active_voxels;
+  e.triangles = saturate(double(active_voxels) * kTrianglesPerActiveVoxel);
+  e.grid_bytes = saturate(double(active_voxels) * kGridBytesPerActiveVoxel);
+  e.mesh_bytes = saturate(double(e.triangles) * kMeshBytesPerTriangle);
   return e;
 }
 
 MemoryEstimate estimate_voxelize(const GeometrySet& set, const VolumeOptions& options) {
-  MemoryEstimate e = estimate_from_area(surface_area_bound_mm2(set), options);
+  const double area = surface_area_bound_mm2(set);
+  MemoryEstimate e = estimate_from_voxels(band_voxels(area, bounding_box(set), options), options);
+  e.surface_area_mm2 = area;
   // Rasterization work space: one pair per leaf in each primitive's box (an upper bound).
   const double leaf = 8.0 * options.voxel_size_mm, band = options.voxel_size_mm * options.half_band_voxels;
   auto leaves = [&](const Vec3d& size) {
     return ((size.x + 2 * band) / leaf + 1.0) * ((size.y + 2 * band) / leaf + 1.0) * ((size.z + 2 * band) / leaf + 1.0);
   };
   double pairs = 0;
-  for (const Tube& tube : set.tubes.tubes)
+  for (const Tube& tube : set.tubes.tubes) {
+    const double r = *std::max_element(tube.radii_mm.begin(), tube.radii_mm.end());
     for (size_t i = 0; i + 1 < std::max<size_t>(tube.points_mm.size(), 2); ++i) {
       Box3 box;
-      double r = *std::max_element(tube.radii_mm.begin(), tube.radii_mm.end());
-      const Vec3d& a = tube.points_mm[i];
-      const Vec3d& b = tube.points_mm[std::min(i + 1, tube.points_mm.size() - 1)];
-      box.expand(a);
-      box.expand(b);
+      box.expand(tube.points_mm[i]);
+      box.expand(tube.points_mm[std::min(i + 1, tube.points_mm.size() - 1)]);
       pairs += leaves(box.size() + Vec3d{2 * r, 2 * r, 2 * r});
     }
+  }
   for (size_t i = 0; i < set.spheres.centers_mm.size(); ++i) {
     double r = set.spheres.radii_mm.size() == 1 ? set.spheres.radii_mm[0] : set.spheres.radii_mm[i];
     pairs += leaves(Vec3d{2 * r, 2 * r, 2 * r});
@@ -60,7 +69,7 @@ MemoryEstimate estimate_voxelize(const GeometrySet& set, const VolumeOptions& op
     pairs += leaves(bounding_box(one).size());
   }
   for (const ThickSurface& ts : set.surfaces) pairs += double(ts.surface.triangles.size()) * 8.0;
-  e.grid_bytes += uint64_t(std::min(pairs * kPairBytes, 1e19));
+  e.grid_bytes += saturate(pairs * kPairBytes);
   return e;
 }
 

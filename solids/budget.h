@@ -12,20 +12,20 @@ namespace lacuna {
 
 struct MemoryEstimate {
   double surface_area_mm2 = 0;  // upper bound of the surface to be resolved
-  uint64_t active_voxels = 0;   // narrow-band voxels of the result
-  uint64_t triangles = 0;       // triangles of its extracted surface
+  uint64_t active_voxels = 0;   // narrow-band voxels
+  uint64_t triangles = 0;       // triangles of the extracted surface
   uint64_t grid_bytes = 0;      // level set plus rasterization work space
-  uint64_t mesh_bytes = 0;      // extraction, writing, re-reading and checking the mesh
-  uint64_t bytes() const { return grid_bytes > mesh_bytes ? grid_bytes : mesh_bytes; }
+  uint64_t mesh_bytes = 0;      // extracting, writing, re-reading and checking the surface
 };
 
-// Estimate for voxelizing a geometry set.
+// Narrow-band voxels a surface of this area needs, capped by the voxels of the box it lies in
+// (a dense union cannot have more band than its box has voxels).
+uint64_t band_voxels(double surface_area_mm2, const Box3& box, const VolumeOptions& options);
+
+// Estimate for a level set with this many active voxels, and for meshing and checking it.
+MemoryEstimate estimate_from_voxels(uint64_t active_voxels, const VolumeOptions& options);
+
+// Estimate for voxelizing a geometry set: its level set, the rasterizer's work space, its mesh.
 MemoryEstimate estimate_voxelize(const GeometrySet& set, const VolumeOptions& options);
-
-// Estimate for a level set (and its mesh) whose surface has the given area.
-MemoryEstimate estimate_from_area(double surface_area_mm2, const VolumeOptions& options);
-
-// Bytes for meshing and checking a surface of `triangles` triangles.
-uint64_t estimate_mesh_bytes(uint64_t triangles);
 
 }  // namespace lacuna

@@ -11,6 +11,7 @@
 #include <atomic>
 #include <cmath>
 #include <numeric>
+#include <unordered_map>
 
 #include "util/progress.h"
 
@@ -47,12 +48,84 @@ class DisjointSets {
   std::vector<uint32_t> parent_;
 };
 
-// Solid angle of triangle abc seen from the origin (Van Oosterom and Strackee).
-double solid_angle(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
-  double la = norm(a), lb = norm(b), lc = norm(c);
-  double num = dot(a, cross(b, c));
-  double den = la * lb * lc + dot(a, b) * lc + dot(a, c) * lb + dot(b, c) * la;
-  return 2.0 * std::atan2(num, den);
+// Orientation of (a, b, p) in the (y, z) projection, exact, with p moved by the infinitesimal
+// (eps, eps^2) when it lies on the line ab (simulation of simplicity): two triangles sharing an
+// edge then never both contain p, and a ray through a vertex or along an edge is counted once.
+int orient_yz(const Vec3d& a, const Vec3d& b, const Vec3d& p) {
+  CGAL::Orientation o = CGAL::orientation(Kernel::Point_2(a.y, a.z), Kernel::Point_2(b.y, b.z), Kernel::Point_2(p.y, p.z));
+  if (o != CGAL::COLLINEAR) return o == CGAL::LEFT_TURN ? 1 : -1;
+  if (b.z != a.z) return b.z > a.z ? -1 : 1;
+  return b.y > a.y ? 1 : (b.y < a.y ? -1 : 0);
+}
+
+// Whether the ray from p along +x crosses triangle abc (exact predicates).
+bool ray_crosses(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& p) {
+  CGAL::Orientation projected =
+      CGAL::orientation(Kernel::Point_2(a.y, a.z), Kernel::Point_2(b.y, b.z), Kernel::Point_2(c.y, c.z));
+  if (projected == CGAL::COLLINEAR) return false;  // parallel to the ray
+  int s = projected == CGAL::LEFT_TURN ? 1 : -1;
+  if (orient_yz(a, b, p) != s || orient_yz(b, c, p) != s || orient_yz(c, a, p) != s) return false;
+  CGAL::Orientation side = CGAL::orientation(Point(a.x, a.y, a.z), Point(b.x, b.y, b.z), Point(c.x, c.y, c.z),
+                                             Point(p.x, p.y, p.z));
+  if (side == CGAL::COPLANAR) return false;
+  // The plane meets the ray ahead of p when p lies on the side the +x direction leaves.
+  return (side == CGAL::POSITIVE ? 1 : -1) * s < 0;
+}
+
+// For every component, how many other components enclose it: the parity of the crossings of a
+// ray from one of its points along +x with each other component. Triangles are matched to the
+// probes through a grid over (y, z), so the cost is one pass over the triangles.
+std::vector<uint32_t> nesting_depths(const TriMesh& mesh, const std::vector<uint32_t>& component_of, size_t nc) {
+  std::vector<uint32_t> depth(nc, 0);
+  if (nc < 2) return depth;
+  std::vector<Vec3d> probe(nc);
+  std::vector<uint8_t> has_probe(nc, 0);
+  for (const auto& t : mesh.triangles) {
+    uint32_t c = component_of[t[0]];
+    if (has_probe[c]) continue;
+    probe[c] = (mesh.positions_mm[t[0]] + mesh.positions_mm[t[1]] + mesh.positions_mm[t[2]]) / 3.0;
+    has_probe[c] = 1;
+  }
+  Box3 box;
+  for (const Vec3d& p : probe) box.expand(p);
+  const double cell = std::max({box.size().y, box.size().z, 1e-9}) / std::max(1.0, std::ceil(std::sqrt(double(nc))));
+  auto cell_of = [&](double y, double z) {
+    return std::make_pair(int64_t(std::floor((y - box.min.y) / cell)), int64_t(std::floor((z - box.min.z) / cell)));
+  };
+  std::unordered_map<uint64_t, std::vector<uint32_t>> probes_in_cell;
+  auto key = [](int64_t i, int64_t j) { return (uint64_t(i + (int64_t(1) << 31)) << 32) | uint64_t(j + (int64_t(1) << 31)); };
+  for (uint32_t c = 0; c < nc; ++c) {
+    auto [i, j] = cell_of(probe[c].y, probe[c].z);
+    probes_in_cell[key(i, j)].push_back(c);
+  }
+  std::vector<std::vector<uint32_t>> crossed(nc);  // components whose surface each probe's ray crosses
+  for (const auto& t : mesh.triangles) {
+    const Vec3d &a = mesh.positions_mm[t[0]], &b = mesh.positions_mm[t[1]], &c = mesh.positions_mm[t[2]];
+    double y0 = std::min({a.y, b.y, c.y}), y1 = std::max({a.y, b.y, c.y});
+    double z0 = std::min({a.z, b.z, c.z}), z1 = std::max({a.z, b.z, c.z});
+    if (y1 < box.min.y || y0 > box.max.y || z1 < box.min.z || z0 > box.max.z) continue;
+    auto [i0, j0] = cell_of(std::max(y0, box.min.y), std::max(z0, box.min.z));
+    auto [i1, j1] = cell_of(std::min(y1, box.max.y), std::min(z1, box.max.z));
+    const uint32_t owner = component_of[t[0]];
+    for (int64_t i = i0; i <= i1; ++i)
+      for (int64_t j = j0; j <= j1; ++j) {
+        auto it = probes_in_cell.find(key(i, j));
+        if (it == probes_in_cell.end()) continue;
+        for (uint32_t q : it->second)
+          if (q != owner && probe[q].x <= std::max({a.x, b.x, c.x}) && ray_crosses(a, b, c, probe[q]))
+            crossed[q].push_back(owner);
+      }
+  }
+  for (size_t q = 0; q < nc; ++q) {
+    std::sort(crossed[q].begin(), crossed[q].end());
+    for (size_t i = 0; i < crossed[q].size();) {
+      size_t j = i;
+      while (j < crossed[q].size() && crossed[q][j] == crossed[q][i]) ++j;
+      depth[q] += (j - i) % 2;
+      i = j;
+    }
+  }
+  return depth;
 }
 
 // CGAL's test run on slabs of the mesh in parallel: faces sorted along the longest axis, cut
@@ -267,13 +340,8 @@ MeshCheckReport check_mesh(const TriMesh& mesh, const CheckOptions& options) {
   const size_t nc = r.components;
   std::vector<int64_t> euler(nc, 0);
   std::vector<long double> volume6(nc, 0);
-  std::vector<Box3> component_box(nc);
-  std::vector<std::vector<uint32_t>> component_faces(nc);
   for (size_t v = 0; v < nv; ++v)
-    if (component_of[v] != UINT32_MAX) {
-      ++euler[component_of[v]];
-      component_box[component_of[v]].expand(mesh.positions_mm[v]);
-    }
+    if (component_of[v] != UINT32_MAX) ++euler[component_of[v]];
   for (uint64_t key : edge_keys) --euler[component_of[key >> 32]];
   const Vec3d center = (r.bounding_box.min + r.bounding_box.max) * 0.5;
   long double area2 = 0;
@@ -281,7 +349,6 @@ MeshCheckReport check_mesh(const TriMesh& mesh, const CheckOptions& options) {
     const auto& t = mesh.triangles[f];
     uint32_t c = component_of[t[0]];
     ++euler[c];
-    if (nc > 1) component_faces[c].push_back(uint32_t(f));
     Vec3d a = mesh.positions_mm[t[0]] - center, b = mesh.positions_mm[t[1]] - center,
           d = mesh.positions_mm[t[2]] - center;
     volume6[c] += dot(a, cross(b, d));
@@ -296,35 +363,12 @@ MeshCheckReport check_mesh(const TriMesh& mesh, const CheckOptions& options) {
   r.area_mm2 = double(area2 / 2.0L);
 
   // Outward orientation: a component nested inside an odd number of others bounds a cavity and
-  // must have negative volume; every other component positive. Nesting depth from the winding
-  // number of one of its vertices with respect to each other component that could contain it.
+  // must have negative volume; every other component positive.
   if (edges_clean) {
     r.orientation_checked = true;
-    std::vector<uint32_t> probe(nc, UINT32_MAX);
-    for (size_t v = 0; v < nv; ++v)
-      if (component_of[v] != UINT32_MAX && probe[component_of[v]] == UINT32_MAX) probe[component_of[v]] = uint32_t(v);
-    std::atomic<uint64_t> inward{0};
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, nc, 1), [&](const tbb::blocked_range<size_t>& range) {
-      for (size_t c = range.begin(); c != range.end(); ++c) {
-        const Vec3d p = mesh.positions_mm[probe[c]];
-        int depth = 0;
-        for (size_t o = 0; o < nc && nc > 1; ++o) {
-          if (o == c) continue;
-          const Box3& b = component_box[o];
-          if (p.x < b.min.x || p.y < b.min.y || p.z < b.min.z || p.x > b.max.x || p.y > b.max.y || p.z > b.max.z)
-            continue;
-          double omega = 0;
-          for (uint32_t f : component_faces[o]) {
-            const auto& t = mesh.triangles[f];
-            omega += solid_angle(mesh.positions_mm[t[0]] - p, mesh.positions_mm[t[1]] - p, mesh.positions_mm[t[2]] - p);
-          }
-          if (std::fabs(omega) > 2.0 * 3.14159265358979323846) ++depth;
-        }
-        bool should_be_positive = depth % 2 == 0;
-        if ((volume6[c] > 0) != should_be_positive) ++inward;
-      }
-    });
-    r.inward_components = inward;
+    std::vector<uint32_t> depth = nesting_depths(mesh, component_of, nc);
+    for (size_t c = 0; c < nc; ++c)
+      if ((volume6[c] > 0) != (depth[c] % 2 == 0)) ++r.inward_components;
   }
   progress.advance();
 

@@ -83,6 +83,33 @@ TEST(Check, NestedShellsNeedTheInnerOneInward) {
   EXPECT_EQ(bad.inward_components, 1u);
 }
 
+// Cube [-h, h]^3, each face split along the diagonal from (-,-) to (+,+) corners, outward.
+TriMesh cube(double h) {
+  TriMesh m;
+  for (int i = 0; i < 8; ++i) m.positions_mm.push_back({i & 1 ? h : -h, i & 2 ? h : -h, i & 4 ? h : -h});
+  m.triangles = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
+                 {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
+  return m;
+}
+
+TEST(Check, NestingThroughAnEdgeIsCountedOnce) {
+  // The inner octahedron's probe (the centroid of its first face) has y = z, so its ray along +x
+  // runs exactly through the diagonal edge of the cube's +x face: one crossing, not two.
+  TriMesh outer = cube(10);
+  ASSERT_GT(check_mesh(outer).volume_mm3, 0);
+  TriMesh inner = octahedron({1, 2, 2}, 3);
+  MeshCheckReport good = check_mesh(merged(outer, flipped(inner)));
+  EXPECT_TRUE(good.valid()) << ::testing::PrintToString(good.problems());
+  EXPECT_EQ(good.inward_components, 0u);
+  MeshCheckReport bad = check_mesh(merged(outer, inner));
+  EXPECT_EQ(bad.inward_components, 1u);
+  // Three levels: a solid island inside the cavity is outward again.
+  TriMesh island = octahedron({1, 2, 2}, 1);
+  MeshCheckReport three = check_mesh(merged(merged(outer, flipped(inner)), island));
+  EXPECT_TRUE(three.valid()) << ::testing::PrintToString(three.problems());
+  EXPECT_EQ(three.components, 3u);
+}
+
 TEST(Check, OverlappingShellsSelfIntersect) {
   MeshCheckReport r = check_mesh(merged(octahedron({0, 0, 0}, 3), octahedron({2, 0.3, 0.1}, 3)));
   EXPECT_TRUE(r.self_intersections_checked);

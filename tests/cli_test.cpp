@@ -211,7 +211,7 @@ TEST(Cli, HelpVersionAndUsageErrors) {
 TEST(Cli, RefusesBeyondTheMemoryBudgetBeforeAllocating) {
   TempDir dir;
   fs::path recipe = fs::path(LACUNA_SOURCE_DIR) / "samples" / "lattice_block.json";
-  Result r = lacuna("run " + quote(recipe.string()) + " -o " + quote((dir / "out").string()) + " --max-memory 0.02",
+  Result r = lacuna("run " + quote(recipe.string()) + " -o " + quote((dir / "out").string()) + " --max-memory 0.2",
                     dir.path());
   EXPECT_EQ(r.code, 3) << r.err;
   EXPECT_NE(r.err.find("voxel size of"), std::string::npos) << r.err;
@@ -220,7 +220,7 @@ TEST(Cli, RefusesBeyondTheMemoryBudgetBeforeAllocating) {
   std::smatch m;
   ASSERT_TRUE(std::regex_search(r.err, m, std::regex("a voxel size of ([0-9.eE+-]+) mm")));
   Result fits = lacuna("run " + quote(recipe.string()) + " -o " + quote((dir / "out").string()) +
-                           " --max-memory 0.02 --quiet --voxel-size " + m[1].str(), dir.path());
+                           " --max-memory 0.2 --quiet --voxel-size " + m[1].str(), dir.path());
   EXPECT_EQ(fits.code, 0) << fits.err;
 
   // Petabytes: refused at once, not after trying.

@@ -115,41 +115,82 @@ Plan make_plan(const Recipe& recipe) {
   return plan;
 }
 
-// Memory for everything the plan builds, refused before any large allocation.
-MemoryEstimate estimate(const Recipe& recipe, const Plan& plan, const VolumeOptions& vopt) {
-  std::map<std::string, double> area;
-  MemoryEstimate total;
+// Memory for everything the plan builds, refused before any large allocation: every level set
+// it keeps (conservatively, all of them at once) plus the largest surface it meshes and checks.
+struct Estimate {
+  uint64_t grid_bytes = 0;
+  uint64_t mesh_bytes = 0;
+  uint64_t voxels = 0;
+  uint64_t triangles = 0;
+  uint64_t bytes() const { return grid_bytes + mesh_bytes; }
+};
+
+Estimate estimate(const Recipe& recipe, const Plan& plan, const VolumeOptions& vopt) {
+  struct Object {
+    double area = 0;
+    Box3 box;
+    uint64_t voxels = 0;
+  };
+  std::map<std::string, Object> objects;
+  Estimate total;
+  auto mesh_of = [&](uint64_t voxels) {
+    MemoryEstimate m = estimate_from_voxels(voxels, vopt);
+    if (m.mesh_bytes > total.mesh_bytes) {
+      total.mesh_bytes = m.mesh_bytes;
+      total.triangles = m.triangles;
+    }
+  };
   for (const RecipeInput& in : recipe.inputs) {
     if (!plan.needed.count(in.name)) continue;
     MemoryEstimate e = in_context(recipe.file + ": " + in.json_path, [&] { return estimate_voxelize(in.geometry, vopt); });
-    area[in.name] = e.surface_area_mm2;
+    objects[in.name] = {e.surface_area_mm2, bounding_box(in.geometry), e.active_voxels};
     total.grid_bytes += e.grid_bytes;
-    total.active_voxels += e.active_voxels;
+    total.voxels += e.active_voxels;
   }
   for (const RecipeOperation& op : recipe.operations) {
     if (!plan.needed.count(op.name)) continue;
-    double a = 0;
-    for (const std::string& o : op.operands) a += area[o];
-    area[op.name] = a;
-    MemoryEstimate e = estimate_from_area(a, vopt);
-    if (op.kind == RecipeOperation::Kind::kOffset || op.kind == RecipeOperation::Kind::kShell) {
-      // The offset goes through the surface mesh and a band as wide as the distance.
-      double d = op.kind == RecipeOperation::Kind::kOffset ? std::fabs(op.distance_mm) : op.thickness_mm;
-      VolumeOptions wide = vopt;
-      wide.half_band_voxels = vopt.half_band_voxels + d / vopt.voxel_size_mm;
-      MemoryEstimate w = estimate_from_area(a, wide);
-      e.grid_bytes += w.grid_bytes + e.mesh_bytes / 4;
+    Object o;
+    const Object& first = objects[op.operands[0]];
+    o.box = first.box;
+    for (const std::string& name : op.operands) {
+      o.area += objects[name].area;
+      if (op.kind == RecipeOperation::Kind::kUnion) o.box.expand(objects[name].box);
     }
+    VolumeOptions work = vopt;
+    if (op.kind == RecipeOperation::Kind::kOffset || op.kind == RecipeOperation::Kind::kShell) {
+      // Goes through the operand's surface mesh and a band as wide as the distance.
+      double d = op.kind == RecipeOperation::Kind::kOffset ? std::fabs(op.distance_mm) : op.thickness_mm;
+      mesh_of(first.voxels);
+      work.half_band_voxels += d / vopt.voxel_size_mm;
+      if (op.kind == RecipeOperation::Kind::kOffset && op.distance_mm > 0) {
+        o.box.min -= Vec3d{d, d, d};
+        o.box.max += Vec3d{d, d, d};
+      }
+      MemoryEstimate wide = estimate_from_voxels(band_voxels(o.area, o.box, work), work);
+      total.grid_bytes += wide.grid_bytes;
+    }
+    o.voxels = band_voxels(o.area, o.box, vopt);
+    MemoryEstimate e = estimate_from_voxels(o.voxels, vopt);
     total.grid_bytes += e.grid_bytes;
-    total.active_voxels += e.active_voxels;
+    total.voxels += e.active_voxels;
+    objects[op.name] = o;
   }
-  double largest = 0;
-  for (const RecipeOutput& out : recipe.outputs) largest = std::max(largest, area[out.object]);
-  MemoryEstimate mesh = estimate_from_area(largest, vopt);
-  total.surface_area_mm2 = largest;
-  total.triangles = mesh.triangles;
-  total.mesh_bytes = mesh.mesh_bytes;
+  for (const RecipeOutput& out : recipe.outputs) mesh_of(objects[out.object].voxels);
   return total;
+}
+
+std::string refusal(const std::string& what, uint64_t need, uint64_t budget, const VolumeOptions& vopt) {
+  // Memory goes with the surface resolved, about 1 / voxel size^2.
+  double scale = std::sqrt(double(need) / double(budget)) * 1.05;
+  return what + " needs about " + format_bytes(need) + ", more than the budget of " + format_bytes(budget) +
+         " (--max-memory); a voxel size of " + fixed(vopt.voxel_size_mm * scale, 3) + " mm or larger would fit" +
+         " (now " + fixed(vopt.voxel_size_mm, 4) + " mm)";
+}
+
+// Refuses, before meshing, a surface whose mesh and checks would not fit next to what is in use.
+void require_mesh_memory(const Volume& v, uint64_t budget, const std::string& what, const VolumeOptions& vopt) {
+  uint64_t need = estimate_from_voxels(v.active_voxel_count(), vopt).mesh_bytes + current_memory_bytes();
+  if (need > budget) throw ResourceLimit(refusal(what, need, budget, vopt));
 }
 
 }  // namespace
@@ -178,16 +219,12 @@ RunResult run_recipe(const std::string& recipe_path, const RunOptions& options) 
                         fixed(kMaxCoordinateInVoxels, 6) + " voxels of " + fixed(vopt.voxel_size_mm, 6) +
                         " mm; float32 output cannot keep such a fine surface exact. Move the part nearer the origin "
                         "or use a voxel size of at least " + fixed(reach / kMaxCoordinateInVoxels, 3) + " mm");
-  MemoryEstimate need = estimate(recipe, plan, vopt);
-  const uint64_t need_bytes = need.grid_bytes + need.mesh_bytes;
-  if (need_bytes > budget) {
-    double scale = std::sqrt(double(need_bytes) / double(budget)) * 1.05;
-    throw ResourceLimit(recipe.file + ": needs about " + format_bytes(need_bytes) + " (voxel size " +
-                        fixed(vopt.voxel_size_mm, 4) + " mm, about " + fixed(double(need.active_voxels), 3) +
-                        " voxels and " + fixed(double(need.triangles), 3) + " triangles), more than the budget of " +
-                        format_bytes(budget) + " (--max-memory); a voxel size of " +
-                        fixed(vopt.voxel_size_mm * scale, 3) + " mm or larger would fit");
-  }
+  Estimate need = estimate(recipe, plan, vopt);
+  const uint64_t need_bytes = need.bytes();
+  if (need_bytes > budget)
+    throw ResourceLimit(refusal(recipe.file + ": this recipe (about " + fixed(double(need.voxels), 3) + " voxels and " +
+                                    fixed(double(need.triangles), 3) + " triangles)",
+                                need_bytes, budget, vopt));
 
   fs::path out_dir = options.output_dir.empty() ? fs::path(recipe.name + "-out") : fs::path(options.output_dir);
   std::error_code ec;
@@ -233,10 +270,14 @@ RunResult run_recipe(const std::string& recipe_path, const RunOptions& options) 
           for (size_t i = 1; i < op.operands.size(); ++i) v = intersect(v, take(op.operands[i]));
           break;
         case RecipeOperation::Kind::kOffset:
-          v = offset(take(op.operands[0]), op.distance_mm);
+          v = take(op.operands[0]);
+          require_mesh_memory(v, budget, recipe.file + ": " + op.json_path, vopt);
+          v = offset(v, op.distance_mm);
           break;
         case RecipeOperation::Kind::kShell:
-          v = shell(take(op.operands[0]), op.thickness_mm);
+          v = take(op.operands[0]);
+          require_mesh_memory(v, budget, recipe.file + ": " + op.json_path, vopt);
+          v = shell(v, op.thickness_mm);
           break;
       }
       volumes[op.name] = v;
@@ -251,6 +292,7 @@ RunResult run_recipe(const std::string& recipe_path, const RunOptions& options) 
       timer.start("mesh");
       Volume volume = take(object);
       const uint64_t voxels = volume.active_voxel_count();
+      require_mesh_memory(volume, budget, recipe.file + ": meshing \"" + object + "\"", vopt);
       TriMesh mesh = extract_surface(volume);
       volume = Volume();
       if (mesh.triangles.empty())

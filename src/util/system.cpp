@@ -24,18 +24,25 @@ uint64_t available_memory_bytes() {
   return physical;
 }
 
-uint64_t peak_memory_bytes() {
+namespace {
+uint64_t status_field_bytes(const char* field) {
   std::ifstream in("/proc/self/status");
   std::string line;
+  const std::string prefix = std::string(field) + ":";
   while (std::getline(in, line)) {
-    if (line.rfind("VmHWM:", 0) == 0) {
+    if (line.rfind(prefix, 0) == 0) {
       uint64_t kib = 0;
-      std::istringstream(line.substr(6)) >> kib;
+      std::istringstream(line.substr(prefix.size())) >> kib;
       return kib * 1024;
     }
   }
   return 0;
 }
+}  // namespace
+
+uint64_t peak_memory_bytes() { return status_field_bytes("VmHWM"); }
+
+uint64_t current_memory_bytes() { return status_field_bytes("VmRSS"); }
 
 void StageTimer::start(const std::string& stage) {
   stop();

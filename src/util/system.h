@@ -16,6 +16,9 @@ uint64_t available_memory_bytes();
 // Peak resident set size of this process so far, in bytes (VmHWM); 0 where unknown.
 uint64_t peak_memory_bytes();
 
+// Resident set size of this process now, in bytes (VmRSS); 0 where unknown.
+uint64_t current_memory_bytes();
+
 // Wall-clock seconds per named stage, in the order the stages ran.
 class StageTimer {
  public:
