@@ -32,3 +32,11 @@ set_target_properties(lacuna::tetgen PROPERTIES
   IMPORTED_LOCATION "${TETGEN_LIBRARY}"
   INTERFACE_INCLUDE_DIRECTORIES "${TETGEN_INCLUDE_DIR}"
   INTERFACE_COMPILE_DEFINITIONS TETLIBRARY)
+
+# libzip (lib3mf's own dependency): the 3MF reader scans model parts before lib3mf parses them.
+find_path(LIBZIP_INCLUDE_DIR zip.h REQUIRED)
+find_library(LIBZIP_LIBRARY NAMES zip REQUIRED)
+add_library(lacuna::libzip UNKNOWN IMPORTED)
+set_target_properties(lacuna::libzip PROPERTIES
+  IMPORTED_LOCATION "${LIBZIP_LIBRARY}"
+  INTERFACE_INCLUDE_DIRECTORIES "${LIBZIP_INCLUDE_DIR}")

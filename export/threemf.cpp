@@ -1,10 +1,13 @@
 // 3MF reading and writing through lib3mf 1.8's C interface.
 #include <sys/stat.h>
 
+#include <zip.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <map>
 #include <memory>
 #include <new>
@@ -425,6 +428,86 @@ bool has_control_character(const std::string& text) {
   return false;
 }
 
+
+// lib3mf 1.8 walks every path through nested components while it reads, so a few kilobytes of
+// components nested ten deep hang it. The model parts are scanned here first (streamed through
+// libzip) and the build's number of object instances bounded before lib3mf sees the file.
+constexpr double kMaxInstances = 1e6;
+
+void precheck_components(const std::string& path) {
+  int error = 0;
+  std::unique_ptr<zip_t, int (*)(zip_t*)> archive(zip_open(path.c_str(), ZIP_RDONLY, &error), zip_close);
+  if (!archive) return;  // not a zip: lib3mf says so in its own words
+  std::map<std::string, std::vector<std::string>> children;  // object id -> component object ids
+  std::vector<std::string> items;
+  const zip_int64_t entries = zip_get_num_entries(archive.get(), 0);
+  for (zip_int64_t e = 0; e < entries; ++e) {
+    const char* name = zip_get_name(archive.get(), zip_uint64_t(e), 0);
+    std::string entry = name ? name : "";
+    if (entry.size() < 6 || entry.compare(entry.size() - 6, 6, ".model") != 0) continue;
+    std::unique_ptr<zip_file_t, int (*)(zip_file_t*)> file(zip_fopen_index(archive.get(), zip_uint64_t(e), 0),
+                                                           zip_fclose);
+    if (!file) continue;
+    std::string tag, current_object;
+    bool in_tag = false;
+    char buffer[1 << 16];
+    auto attribute = [](const std::string& t, const char* key) {
+      std::string pattern = std::string(" ") + key + "=\"";
+      size_t at = t.find(pattern);
+      if (at == std::string::npos) return std::string();
+      size_t begin = at + pattern.size(), end = t.find('"', begin);
+      return end == std::string::npos ? std::string() : t.substr(begin, end - begin);
+    };
+    for (zip_int64_t got; (got = zip_fread(file.get(), buffer, sizeof buffer)) > 0;) {
+      for (zip_int64_t i = 0; i < got; ++i) {
+        char c = buffer[i];
+        if (!in_tag) {
+          if (c == '<') {
+            in_tag = true;
+            tag.clear();
+          }
+          continue;
+        }
+        if (c != '>') {
+          if (tag.size() < 4096) tag.push_back(c == '\t' || c == '\n' || c == '\r' ? ' ' : c);
+          continue;
+        }
+        in_tag = false;
+        if (tag.rfind("object ", 0) == 0) {
+          current_object = attribute(tag, "id");
+          children[current_object];
+        } else if (tag.rfind("/object", 0) == 0) {
+          current_object.clear();
+        } else if (tag.rfind("component ", 0) == 0 && !current_object.empty()) {
+          children[current_object].push_back(attribute(tag, "objectid"));
+        } else if (tag.rfind("item ", 0) == 0) {
+          items.push_back(attribute(tag, "objectid"));
+        }
+      }
+    }
+  }
+  // Instances per object, memoized; a cycle is an error of the file.
+  std::map<std::string, double> instances;
+  std::set<std::string> open;
+  std::function<double(const std::string&, int)> count = [&](const std::string& id, int depth) -> double {
+    if (auto found = instances.find(id); found != instances.end()) return found->second;
+    if (depth > 64 || !open.insert(id).second)
+      throw InvalidInput(cat(path, ": components of object ", id, " refer back to themselves or nest deeper than 64"));
+    double n = 0;
+    auto it = children.find(id);
+    if (it == children.end() || it->second.empty()) n = 1;
+    else
+      for (const std::string& child : it->second) n += count(child, depth + 1);
+    open.erase(id);
+    return instances[id] = n;
+  };
+  double total = 0;
+  for (const std::string& item : items) total += count(item, 0);
+  if (total > kMaxInstances)
+    throw ResourceLimit(cat(path, ": the build expands to ", total, " object instances through nested components,",
+                            " more than ", uint64_t(kMaxInstances)));
+}
+
 }  // namespace
 
 #if defined(__SANITIZE_ADDRESS__)  // GCC
@@ -441,6 +524,7 @@ extern "C" const char* __lsan_default_suppressions() { return "leak:libzip.so\n"
 #endif
 
 TriMesh read_3mf(const std::string& path, const ReadOptions& options) {
+  precheck_components(path);
   // lib3mf unpacks the model before anything can be counted; the archive's directory bounds it.
   double unpacked = zip_uncompressed_bytes(path);
   if (unpacked > double(options.max_memory_bytes)) {

@@ -56,10 +56,22 @@ struct Block {
   openvdb::Coord origin;
   uint32_t neighbours[8];            // block index of origin + 8 * bits(k); UINT32_MAX if none
   std::vector<uint16_t> edge_keys;   // local voxel offset * 8 + direction, ascending
-  std::vector<Vec3d> positions;      // crossing point of each edge key, in mm
+  std::vector<float> fractions;      // where each edge is crossed, from its first end (0..1)
   uint64_t first_vertex = 0;
-  std::vector<std::array<uint32_t, 3>> triangles;
+  uint64_t triangle_count = 0;
+  uint64_t first_triangle = 0;
 };
+
+// Triangles the six tetrahedra of a cube produce, from the cube's inside-corner bits.
+int triangles_in_cube(int inside) {
+  int n = 0;
+  for (const auto& tet : kTets) {
+    int in_count = 0;
+    for (int k = 0; k < 4; ++k) in_count += (inside >> tet[k]) & 1;
+    n += in_count == 2 ? 2 : (in_count == 1 || in_count == 3 ? 1 : 0);
+  }
+  return n;
+}
 
 constexpr uint32_t kNone = UINT32_MAX;
 
@@ -80,13 +92,6 @@ void load_values(const openvdb::FloatTree& tree, openvdb::tree::ValueAccessor<co
 }
 
 }  // namespace
-
-uint64_t estimate_extract_bytes(const Volume& volume) {
-  // Measured: about 1.1 crossing points and 2.2 triangles per active voxel of a 3-voxel band,
-  // 24 + 12 bytes each, plus per-block bookkeeping.
-  uint64_t voxels = volume.active_voxel_count();
-  return voxels * 60 + volume.leaf_count() * 4 * 700;
-}
 
 TriMesh extract_surface(const Volume& volume, const ExtractOptions& options) {
   TriMesh mesh;
@@ -121,7 +126,9 @@ TriMesh extract_surface(const Volume& volume, const ExtractOptions& options) {
 
   Progress progress("mesh", blocks.size() * 2);
 
-  // Pass 1: crossing points on the seven edges leaving every visited voxel.
+  // Pass 1: which of the seven edges leaving every visited voxel cross the surface, and where;
+  // how many triangles every block will emit. Nothing is stored twice: pass 2 writes the
+  // vertices and triangles straight into the mesh.
   tbb::parallel_for(tbb::blocked_range<size_t>(0, blocks.size(), 8), [&](const tbb::blocked_range<size_t>& r) {
     openvdb::tree::ValueAccessor<const openvdb::FloatTree> acc(tree);
     float values[729];
@@ -134,34 +141,49 @@ TriMesh extract_surface(const Volume& volume, const ExtractOptions& options) {
         const int x = int(n >> 6), y = int((n >> 3) & 7), z = int(n & 7);
         const float f0 = values[x * 81 + y * 9 + z];
         const bool in0 = f0 < 0;
-        for (int d = 1; d < 8; ++d) {
+        int inside = 0;
+        for (int d = 0; d < 8; ++d) {
           const int dx = d & 1, dy = (d >> 1) & 1, dz = (d >> 2) & 1;
           const float f1 = values[(x + dx) * 81 + (y + dy) * 9 + (z + dz)];
-          if ((f1 < 0) == in0) continue;
-          double t = std::clamp(double(f0) / (double(f0) - double(f1)), eps, 1.0 - eps);
-          openvdb::Coord base = b.origin.offsetBy(x, y, z);
+          inside |= (f1 < 0) << d;
+          if (d == 0 || (f1 < 0) == in0) continue;
           b.edge_keys.push_back(uint16_t(n * 8 + d));
-          b.positions.push_back(Vec3d{(base.x() + t * dx) * h, (base.y() + t * dy) * h, (base.z() + t * dz) * h});
+          b.fractions.push_back(float(std::clamp(double(f0) / (double(f0) - double(f1)), eps, 1.0 - eps)));
         }
+        if (inside != 0 && inside != 0xff) b.triangle_count += triangles_in_cube(inside);
       }
       progress.advance();
     }
   });
 
-  uint64_t vertex_count = 0;
+  uint64_t vertex_count = 0, triangle_count = 0;
   for (Block& b : blocks) {
     b.first_vertex = vertex_count;
-    vertex_count += b.positions.size();
+    vertex_count += b.edge_keys.size();
+    b.first_triangle = triangle_count;
+    triangle_count += b.triangle_count;
   }
   if (vertex_count >= UINT32_MAX) throw std::length_error("surface has more than 4 billion vertices");
+  mesh.positions_mm.resize(vertex_count);
+  mesh.triangles.resize(triangle_count);
 
-  // Pass 2: the triangles of the six tetrahedra of every cube with a sign change.
+  // Pass 2: the crossing points, then the triangles of the six tetrahedra of every cube with a
+  // sign change, each block into its own slice of the mesh.
   tbb::parallel_for(tbb::blocked_range<size_t>(0, blocks.size(), 8), [&](const tbb::blocked_range<size_t>& r) {
     openvdb::tree::ValueAccessor<const openvdb::FloatTree> acc(tree);
     float values[729];
     for (size_t bi = r.begin(); bi != r.end(); ++bi) {
       Block& b = blocks[bi];
       const MaskLeafT& m = *mask_leaves[bi];
+      for (size_t k = 0; k < b.edge_keys.size(); ++k) {
+        const int n = b.edge_keys[k] >> 3, d = b.edge_keys[k] & 7;
+        const double t = b.fractions[k];
+        const openvdb::Coord base = b.origin.offsetBy(n >> 6, (n >> 3) & 7, n & 7);
+        mesh.positions_mm[b.first_vertex + k] = Vec3d{(base.x() + t * (d & 1)) * h, (base.y() + t * ((d >> 1) & 1)) * h,
+                                                      (base.z() + t * ((d >> 2) & 1)) * h};
+      }
+      std::vector<float>().swap(b.fractions);
+      std::array<uint32_t, 3>* out = mesh.triangles.data() + b.first_triangle;
       load_values(tree, acc, b.origin, values);
       for (auto it = m.cbeginValueOn(); it; ++it) {
         const openvdb::Index n = it.pos();
@@ -203,8 +225,8 @@ TriMesh extract_surface(const Volume& volume, const ExtractOptions& options) {
                      c = vertex(tet[p[0]], tet[p[3]]);
             // The triangle (a, bb, c) faces away from the lone corner; outward means away from an
             // inside corner and towards an outside one.
-            if (want_inside) b.triangles.push_back({a, bb, c});
-            else b.triangles.push_back({a, c, bb});
+            if (want_inside) *out++ = {a, bb, c};
+            else *out++ = {a, c, bb};
             continue;
           }
           int ins[2], k2 = 0;
@@ -227,11 +249,11 @@ TriMesh extract_surface(const Volume& volume, const ExtractOptions& options) {
                 l2 = local(tet[p[1]], tet[p[3]]), l3 = local(tet[p[1]], tet[p[2]]);
           Vec3d d02 = l2 - l0, d13 = l3 - l1;
           if (dot(d02, d02) <= dot(d13, d13)) {
-            b.triangles.push_back({q[0], q[1], q[2]});
-            b.triangles.push_back({q[0], q[2], q[3]});
+            *out++ = {q[0], q[1], q[2]};
+            *out++ = {q[0], q[2], q[3]};
           } else {
-            b.triangles.push_back({q[0], q[1], q[3]});
-            b.triangles.push_back({q[1], q[2], q[3]});
+            *out++ = {q[0], q[1], q[3]};
+            *out++ = {q[1], q[2], q[3]};
           }
         }
       }
@@ -239,16 +261,6 @@ TriMesh extract_surface(const Volume& volume, const ExtractOptions& options) {
     }
   });
 
-  uint64_t triangle_count = 0;
-  for (const Block& b : blocks) triangle_count += b.triangles.size();
-  mesh.positions_mm.reserve(vertex_count);
-  mesh.triangles.reserve(triangle_count);
-  for (Block& b : blocks) {
-    mesh.positions_mm.insert(mesh.positions_mm.end(), b.positions.begin(), b.positions.end());
-    mesh.triangles.insert(mesh.triangles.end(), b.triangles.begin(), b.triangles.end());
-    std::vector<Vec3d>().swap(b.positions);
-    std::vector<std::array<uint32_t, 3>>().swap(b.triangles);
-  }
   return mesh;
 }
 

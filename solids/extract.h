@@ -18,7 +18,4 @@ struct ExtractOptions {
 // seen from outside. Deterministic for any number of threads.
 TriMesh extract_surface(const Volume& volume, const ExtractOptions& options = {});
 
-// Estimated bytes of the mesh extract_surface() returns, from the volume's band size.
-uint64_t estimate_extract_bytes(const Volume& volume);
-
 }  // namespace lacuna

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -642,6 +643,31 @@ TEST_F(MeshIoTest, AbsurdSizesThrowResourceLimitBeforeAllocating) {
   tiny.max_memory_bytes = 100;
   EXPECT_TRUE(
       contains(error_of<ResourceLimit>([&] { read_mesh(obj, tiny); }), "many.obj: 5 vertices"));
+}
+
+TEST_F(MeshIoTest, ComponentBombIsRefusedBeforeLib3mfExpandsIt) {
+  // Twelve levels of ten components: 10^12 instances in a few kilobytes. lib3mf 1.8 would walk
+  // every path while reading; the scan before it refuses the file at once.
+  std::string objects = kTetrahedronObject;
+  for (int id = 2; id <= 13; ++id) {
+    objects += "<object id=\"" + std::to_string(id) + "\" type=\"model\"><components>";
+    for (int k = 0; k < 10; ++k) objects += "<component objectid=\"" + std::to_string(id - 1) + "\"/>";
+    objects += "</components></object>";
+  }
+  std::string bomb = write("bomb.3mf", package_3mf(model_xml("millimeter", "<resources>" + objects +
+                                                                              "</resources><build><item "
+                                                                              "objectid=\"13\"/></build>")));
+  auto start = std::chrono::steady_clock::now();
+  std::string message = error_of<ResourceLimit>([&] { read_mesh(bomb); });
+  EXPECT_TRUE(contains(message, "bomb.3mf: the build expands to 1e+12 object instances")) << message;
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 2.0);
+  // A cycle of components is an error of the file.
+  std::string cycle = write("cycle.3mf", package_3mf(model_xml(
+      "millimeter", std::string("<resources>") + kTetrahedronObject +
+                        "<object id=\"2\" type=\"model\"><components><component objectid=\"3\"/></components></object>"
+                        "<object id=\"3\" type=\"model\"><components><component objectid=\"2\"/></components></object>"
+                        "</resources><build><item objectid=\"2\"/></build>")));
+  EXPECT_TRUE(contains(error_of<InvalidInput>([&] { read_mesh(cycle); }), "refer back to themselves"));
 }
 
 TEST_F(MeshIoTest, FormatNamesAndExtensions) {
