@@ -132,7 +132,7 @@ std::vector<uint32_t> nesting_depths(const TriMesh& mesh, const std::vector<uint
 // into slabs, every face handed to each slab its box overlaps, so every pair of faces whose boxes
 // meet is tested in some slab. CGAL's own parallel mode shuffles the boxes and ran no faster than
 // one thread here.
-bool self_intersects(const TriMesh& mesh, const Box3& box, bool& built) {
+bool self_intersects(const TriMesh& mesh, const Box3& box, bool& built, Progress& progress) {
   SurfaceMesh sm;
   sm.reserve(SurfaceMesh::size_type(mesh.positions_mm.size()), SurfaceMesh::size_type(mesh.triangles.size() * 3 / 2),
              SurfaceMesh::size_type(mesh.triangles.size()));
@@ -179,6 +179,7 @@ bool self_intersects(const TriMesh& mesh, const Box3& box, bool& built) {
   tbb::parallel_for(size_t(0), slabs, [&](size_t j) {
     if (hit) return;
     if (CGAL::Polygon_mesh_processing::does_self_intersect<CGAL::Sequential_tag>(members[j], sm)) hit = true;
+    progress.advance(16 / slabs + (j < 16 % slabs ? 1 : 0));
   });
   return hit;
 }
@@ -231,7 +232,7 @@ MeshCheckReport check_mesh(const TriMesh& mesh, const CheckOptions& options) {
   }
   if (nf == 0 || r.bad_indices || r.non_finite_vertices) return r;
 
-  Progress progress("check", 4);
+  Progress progress("check", 4 + 16);
   // Degenerate faces: a repeated corner or three collinear corners (exact predicate).
   r.degenerate_faces = tbb::parallel_reduce(
       tbb::blocked_range<size_t>(0, nf, 4096), uint64_t{0},
@@ -374,7 +375,7 @@ MeshCheckReport check_mesh(const TriMesh& mesh, const CheckOptions& options) {
 
   if (options.self_intersections && edges_clean && r.non_manifold_vertices == 0) {
     bool built = false;
-    bool hit = self_intersects(mesh, r.bounding_box, built);
+    bool hit = self_intersects(mesh, r.bounding_box, built, progress);
     r.self_intersections_checked = built;
     r.self_intersecting = built && hit;
   }

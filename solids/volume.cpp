@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <atomic>
 #include <mutex>
 #include <openvdb/tools/Composite.h>
 #include <openvdb/tools/Interpolation.h>
@@ -12,6 +13,7 @@
 #include "errors.h"
 #include "solids/extract.h"
 #include "solids/vdb_internal.h"
+#include "util/progress.h"
 
 namespace lacuna {
 
@@ -80,13 +82,32 @@ struct TriMeshAdapter {
   }
 };
 
+// Turns meshToVolume's percentages into a progress bar; never interrupts.
+class ProgressInterrupter : public openvdb::util::NullInterrupter {
+ public:
+  explicit ProgressInterrupter(const char* stage) : progress_(stage, 100) {}
+  bool wasInterrupted(int percent = -1) override {
+    int last = last_.load();
+    while (percent > last && !last_.compare_exchange_weak(last, percent)) {
+    }
+    if (percent > last) progress_.advance(uint64_t(percent - last));
+    return false;
+  }
+
+ private:
+  Progress progress_;
+  std::atomic<int> last_{0};
+};
+
 // Signed distance to a closed mesh, exact within `outside_mm` outside and `inside_mm` inside.
-openvdb::FloatGrid::Ptr mesh_distance(const TriMesh& mesh, double h, double outside_mm, double inside_mm) {
+openvdb::FloatGrid::Ptr mesh_distance(const TriMesh& mesh, double h, double outside_mm, double inside_mm,
+                                      const char* stage) {
   ensure_openvdb_initialized();
   TriMeshAdapter adapter{mesh, 1.0 / h};
   auto xform = make_transform(h);
+  ProgressInterrupter interrupter(stage);
   auto grid = openvdb::tools::meshToVolume<openvdb::FloatGrid>(
-      adapter, *xform, static_cast<float>(outside_mm / h + 1.0), static_cast<float>(inside_mm / h + 1.0),
+      interrupter, adapter, *xform, static_cast<float>(outside_mm / h + 1.0), static_cast<float>(inside_mm / h + 1.0),
       openvdb::tools::DISABLE_RENORMALIZATION);
   grid->setGridClass(openvdb::GRID_LEVEL_SET);
   return grid;
@@ -145,7 +166,7 @@ Volume mesh_to_volume(const TriMesh& mesh, const VolumeOptions& options) {
   if (mesh.triangles.empty()) throw InvalidInput("mesh has no triangles");
   auto grid = make_level_set_grid(options);  // validates the options
   double band = options.voxel_size_mm * options.half_band_voxels;
-  grid = mesh_distance(mesh, options.voxel_size_mm, band, band);
+  grid = mesh_distance(mesh, options.voxel_size_mm, band, band, "mesh to volume");
   rebuild_band(*grid, 0.0f, static_cast<float>(band));
   return wrap_grid(grid, options);
 }
@@ -179,7 +200,7 @@ Volume offset(const Volume& v, double distance_mm) {
   TriMesh surface = extract_surface(v);
   const double band = v.band_mm();
   auto grid = mesh_distance(surface, v.voxel_size_mm(), std::max(distance_mm, 0.0) + band,
-                            std::max(-distance_mm, 0.0) + band);
+                            std::max(-distance_mm, 0.0) + band, "offset");
   rebuild_band(*grid, static_cast<float>(distance_mm), static_cast<float>(band));
   return wrap_grid(grid, v.options());
 }

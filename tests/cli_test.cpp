@@ -216,12 +216,14 @@ TEST(Cli, RefusesBeyondTheMemoryBudgetBeforeAllocating) {
   EXPECT_EQ(r.code, 3) << r.err;
   EXPECT_NE(r.err.find("voxel size of"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "out"));
-  // The suggested voxel size fits the same budget.
   std::smatch m;
   ASSERT_TRUE(std::regex_search(r.err, m, std::regex("a voxel size of ([0-9.eE+-]+) mm")));
+#ifndef __SANITIZE_ADDRESS__  // shadow memory inflates the resident set the budget is checked against
+  // The suggested voxel size fits the same budget.
   Result fits = lacuna("run " + quote(recipe.string()) + " -o " + quote((dir / "out").string()) +
                            " --max-memory 0.2 --quiet --voxel-size " + m[1].str(), dir.path());
   EXPECT_EQ(fits.code, 0) << fits.err;
+#endif
 
   // Petabytes: refused at once, not after trying.
   write_file(dir / "huge.json", R"({"voxel_size_mm": 0.0005,
