@@ -69,6 +69,14 @@ MemoryEstimate estimate_voxelize(const GeometrySet& set, const VolumeOptions& op
     pairs += leaves(bounding_box(one).size());
   }
   for (const ThickSurface& ts : set.surfaces) pairs += double(ts.surface.triangles.size()) * 8.0;
+  for (const ConvexCells& cells : set.cells) {
+    const size_t m = size_t(cells.corners_per_cell);
+    for (size_t c = 0; c < cells.size(); ++c) {
+      Box3 box;
+      for (size_t i = 0; i < m; ++i) box.expand(cells.corners_mm[c * m + i]);
+      pairs += leaves(box.size());
+    }
+  }
   e.grid_bytes += saturate(pairs * kPairBytes);
   return e;
 }

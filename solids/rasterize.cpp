@@ -18,7 +18,13 @@ namespace lacuna {
 namespace {
 
 
-enum class PrimKind : uint8_t { kSphere, kCapsule, kRoundCone, kBox, kCylinder, kTorus, kTriangle };
+enum class PrimKind : uint8_t { kSphere, kCapsule, kRoundCone, kBox, kCylinder, kTorus, kTriangle, kCell };
+
+// A face plane of a convex cell: signed distance n . p - offset, n unit, outward.
+struct Plane {
+  Vec3d normal;
+  double offset;
+};
 
 // One primitive with what its distance function needs precomputed.
 struct Prim {
@@ -28,7 +34,14 @@ struct Prim {
   Vec3d ba;                 // b - a for segments
   double r0 = 0, r1 = 0;    // radii (sphere, capsule ends), cylinder radius + half height, ...
   double l2 = 0, inv_l2 = 0, rr = 0, a2 = 0;  // round-cone terms (see round_cone_distance)
+  uint32_t first_plane = 0, plane_count = 0;  // a cell's face planes in the batch's plane list
   Box3 box;
+};
+
+// The primitives of one batch and the face planes of its cells.
+struct Flat {
+  std::vector<Prim> prims;
+  std::vector<Plane> planes;
 };
 
 double segment_distance(const Vec3d& p, const Vec3d& a, const Vec3d& ba, double inv_l2) {
@@ -75,8 +88,18 @@ Vec3d closest_on_triangle(const Vec3d& p, const Vec3d& a, const Vec3d& b, const 
   return a + ab * (vb * denom) + ac * (vc * denom);
 }
 
-double distance(const Prim& q, const Vec3d& p) {
+double distance(const Prim& q, const Plane* planes, const Vec3d& p) {
   switch (q.kind) {
+    case PrimKind::kCell: {
+      // Exact inside a convex cell; outside a lower bound (exact off edges and corners): the zero
+      // set is the cell exactly and the function stays 1-Lipschitz, which is all the band needs.
+      double d = -HUGE_VAL;
+      for (uint32_t i = 0; i < q.plane_count; ++i) {
+        const Plane& f = planes[q.first_plane + i];
+        d = std::max(d, dot(f.normal, p) - f.offset);
+      }
+      return d;
+    }
     case PrimKind::kSphere:
       return norm(p - q.a) - q.r0;
     case PrimKind::kCapsule:
@@ -156,8 +179,9 @@ Prim make_segment(const Vec3d& a, double ra, const Vec3d& b, double rb) {
 Vec3d unit(const Vec3d& v) { return v / norm(v); }
 
 // Every distance-bearing piece of the set, flattened.
-std::vector<Prim> flatten(const GeometrySet& set) {
-  std::vector<Prim> prims;
+Flat flatten(const GeometrySet& set) {
+  Flat flat;
+  std::vector<Prim>& prims = flat.prims;
   prims.reserve(primitive_count(set));
   for (const Tube& tube : set.tubes.tubes) {
     auto radius = [&](size_t i) { return tube.radii_mm.size() == 1 ? tube.radii_mm[0] : tube.radii_mm[i]; };
@@ -224,7 +248,50 @@ std::vector<Prim> flatten(const GeometrySet& set) {
       prims.push_back(q);
     }
   }
-  return prims;
+
+  for (const ConvexCells& cells : set.cells) {
+    const size_t m = size_t(cells.corners_per_cell);
+    for (size_t c = 0; c < cells.size(); ++c) {
+      const Vec3d* v = cells.corners_mm.data() + c * m;
+      Vec3d centroid{0, 0, 0};
+      Prim q;
+      q.kind = PrimKind::kCell;
+      for (size_t i = 0; i < m; ++i) {
+        centroid += v[i];
+        q.box.expand(v[i]);
+      }
+      centroid = centroid / double(m);
+      q.first_plane = uint32_t(flat.planes.size());
+      bool degenerate = false;
+      for (const auto& face : cells.faces) {
+        // Newell's normal is robust for any polygon; the centroid decides which side is out.
+        Vec3d n{0, 0, 0}, mean{0, 0, 0};
+        for (size_t i = 0; i < face.size(); ++i) {
+          const Vec3d &a = v[face[i]], &b = v[face[(i + 1) % face.size()]];
+          n += Vec3d{(a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y)};
+          mean += a;
+        }
+        mean = mean / double(face.size());
+        double length = norm(n);
+        if (!(length > 0)) continue;  // a face collapsed to a line or point adds no constraint
+        n = n / length;
+        double offset = dot(n, mean);
+        if (dot(n, centroid) - offset > 0) {
+          n = -n;
+          offset = -offset;
+        }
+        if (dot(n, centroid) - offset > -1e-12 * (1 + norm(q.box.size()))) degenerate = true;
+        flat.planes.push_back(Plane{n, offset});
+      }
+      q.plane_count = uint32_t(flat.planes.size() - q.first_plane);
+      if (degenerate || q.plane_count < 4) {
+        flat.planes.resize(q.first_plane);  // a flat cell has no interior: nothing to add
+        continue;
+      }
+      prims.push_back(q);
+    }
+  }
+  return flat;
 }
 
 // Leaf coordinates are packed 21 bits per axis.
@@ -262,7 +329,7 @@ struct Grid {
 
 // Adds (leaf, primitive) pairs for the leaves [lo, hi) the primitive's band can reach, refining
 // a block of leaves only where the distance at its centre does not settle it.
-void collect_pairs(const Prim& q, uint32_t index, const int64_t lo[3], const int64_t hi[3],
+void collect_pairs(const Prim& q, const Plane* planes, uint32_t index, const int64_t lo[3], const int64_t hi[3],
                    const Grid& g, std::vector<Pair>& out) {
   Vec3d center, half;
   for (int k = 0; k < 3; ++k) {
@@ -271,7 +338,7 @@ void collect_pairs(const Prim& q, uint32_t index, const int64_t lo[3], const int
     half[k] = 0.5 * (last - first) * g.h;
   }
   double reach = g.band + norm(half);
-  double d = distance(q, center);
+  double d = distance(q, planes, center);
   if (d >= reach) return;
   bool inside = d <= -reach;
   int64_t extent[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
@@ -289,8 +356,8 @@ void collect_pairs(const Prim& q, uint32_t index, const int64_t lo[3], const int
   int64_t lo2[3] = {lo[0], lo[1], lo[2]}, hi1[3] = {hi[0], hi[1], hi[2]};
   hi1[axis] = mid;
   lo2[axis] = mid;
-  collect_pairs(q, index, lo, hi1, g, out);
-  collect_pairs(q, index, lo2, hi, g, out);
+  collect_pairs(q, planes, index, lo, hi1, g, out);
+  collect_pairs(q, planes, index, lo2, hi, g, out);
 }
 
 int64_t floor_div8(int64_t v) { return v >= 0 ? v / 8 : -((-v + 7) / 8); }
@@ -301,120 +368,165 @@ size_t primitive_count(const GeometrySet& set) {
   size_t n = set.spheres.centers_mm.size() + set.shapes.size();
   for (const Tube& t : set.tubes.tubes) n += t.points_mm.size() <= 1 ? 1 : t.points_mm.size() - 1;
   for (const ThickSurface& s : set.surfaces) n += s.surface.triangles.size();
+  for (const ConvexCells& c : set.cells) n += c.size();
   return n;
 }
 
-Volume rasterize_primitives(const GeometrySet& set, const VolumeOptions& options) {
-  ensure_openvdb_initialized();
-  const Grid g{options.voxel_size_mm, options.voxel_size_mm * options.half_band_voxels};
-  const float band = static_cast<float>(g.band);
-  openvdb::FloatGrid::Ptr grid = make_level_set_grid(options);
-  std::vector<Prim> prims = flatten(set);
-  if (prims.empty()) return wrap_grid(grid, options);
+struct PrimitiveRasterizer::Impl {
+  VolumeOptions options;
+  openvdb::FloatGrid::Ptr grid;
+};
 
-  // 1. Which leaves each primitive's band reaches.
+PrimitiveRasterizer::PrimitiveRasterizer(const VolumeOptions& options) : impl_(std::make_unique<Impl>()) {
+  impl_->options = options;
+  impl_->grid = make_level_set_grid(options);
+}
+
+PrimitiveRasterizer::~PrimitiveRasterizer() = default;
+
+void PrimitiveRasterizer::add(const GeometrySet& batch) {
+  const Grid g{impl_->options.voxel_size_mm, impl_->options.voxel_size_mm * impl_->options.half_band_voxels};
+  const float band = static_cast<float>(g.band);
+  const Flat flat = flatten(batch);
+  const std::vector<Prim>& prims = flat.prims;
+  const Plane* planes = flat.planes.data();
+  if (prims.empty()) return;
+  Progress progress("rasterize", prims.size() * 2);
+
+  // 1. Which leaves each primitive's band reaches, sorted so every leaf is computed once from a
+  // list in a fixed order (the result does not depend on the number of threads).
   const double limit = double(kLeafCoordBias - 2) * 8;
   tbb::enumerable_thread_specific<std::vector<Pair>> local_pairs;
-  {
-    Progress progress("rasterize", prims.size() * 2);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, prims.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
-      std::vector<Pair>& out = local_pairs.local();
-      for (size_t i = r.begin(); i != r.end(); ++i) {
-        const Prim& q = prims[i];
-        int64_t lo[3], hi[3];
-        for (int k = 0; k < 3; ++k) {
-          double vlo = std::ceil((q.box.min[k] - g.band) / g.h);
-          double vhi = std::floor((q.box.max[k] + g.band) / g.h);
-          if (!(std::fabs(vlo) < limit && std::fabs(vhi) < limit))
-            throw ResourceLimit("the part spans more voxels than a grid can address; use a larger voxel size");
-          lo[k] = floor_div8(int64_t(vlo));
-          hi[k] = floor_div8(int64_t(vhi)) + 1;
-        }
-        collect_pairs(q, uint32_t(i), lo, hi, g, out);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, prims.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+    std::vector<Pair>& out = local_pairs.local();
+    for (size_t i = r.begin(); i != r.end(); ++i) {
+      const Prim& q = prims[i];
+      int64_t lo[3], hi[3];
+      for (int k = 0; k < 3; ++k) {
+        double vlo = std::ceil((q.box.min[k] - g.band) / g.h);
+        double vhi = std::floor((q.box.max[k] + g.band) / g.h);
+        if (!(std::fabs(vlo) < limit && std::fabs(vhi) < limit))
+          throw ResourceLimit("the part spans more voxels than a grid can address; use a larger voxel size");
+        lo[k] = floor_div8(int64_t(vlo));
+        hi[k] = floor_div8(int64_t(vhi)) + 1;
       }
-      progress.advance(r.size());
-    });
-    std::vector<Pair> pairs;
-    size_t total = 0;
-    for (auto& v : local_pairs) total += v.size();
-    pairs.reserve(total);
-    for (auto& v : local_pairs) {
-      pairs.insert(pairs.end(), v.begin(), v.end());
-      std::vector<Pair>().swap(v);
+      collect_pairs(q, planes, uint32_t(i), lo, hi, g, out);
     }
-    tbb::parallel_sort(pairs.begin(), pairs.end());
+    progress.advance(r.size());
+  });
+  std::vector<Pair> pairs;
+  size_t total = 0;
+  for (auto& v : local_pairs) total += v.size();
+  pairs.reserve(total);
+  for (auto& v : local_pairs) {
+    pairs.insert(pairs.end(), v.begin(), v.end());
+    std::vector<Pair>().swap(v);
+  }
+  tbb::parallel_sort(pairs.begin(), pairs.end());
 
-    // 2. Each leaf's values from its primitives, in parallel; leaves inside a primitive become
-    // interior tiles.
-    std::vector<size_t> starts;
-    for (size_t i = 0; i < pairs.size(); ++i)
-      if (i == 0 || pairs[i].leaf != pairs[i - 1].leaf) starts.push_back(i);
-    starts.push_back(pairs.size());
-    const size_t leaf_count = starts.size() - 1;
-    using LeafT = openvdb::FloatTree::LeafNodeType;
-    std::vector<LeafT*> leaves(leaf_count, nullptr);
-    std::vector<uint8_t> interior(leaf_count, 0);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, leaf_count, 16), [&](const tbb::blocked_range<size_t>& r) {
-      float values[512];
-      for (size_t li = r.begin(); li != r.end(); ++li) {
-        const size_t begin = starts[li], end = starts[li + 1];
-        bool inside = false;
-        for (size_t k = begin; k < end && !inside; ++k) inside = pairs[k].interior != 0;
-        if (inside) {
-          interior[li] = 1;
-          continue;
+  // 2. Each leaf's values from its primitives, in parallel; leaves inside a primitive become
+  // interior tiles.
+  std::vector<size_t> starts;
+  for (size_t i = 0; i < pairs.size(); ++i)
+    if (i == 0 || pairs[i].leaf != pairs[i - 1].leaf) starts.push_back(i);
+  starts.push_back(pairs.size());
+  const size_t leaf_count = starts.size() - 1;
+  using LeafT = openvdb::FloatTree::LeafNodeType;
+  std::vector<std::unique_ptr<LeafT>> leaves(leaf_count);
+  std::vector<uint8_t> interior(leaf_count, 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, leaf_count, 16), [&](const tbb::blocked_range<size_t>& r) {
+    float values[512];
+    for (size_t li = r.begin(); li != r.end(); ++li) {
+      const size_t begin = starts[li], end = starts[li + 1];
+      bool inside = false;
+      for (size_t k = begin; k < end && !inside; ++k) inside = pairs[k].interior != 0;
+      if (inside) {
+        interior[li] = 1;
+        continue;
+      }
+      const openvdb::Coord origin = unpack_leaf_origin(pairs[begin].leaf);
+      std::fill(values, values + 512, band);
+      for (size_t k = begin; k < end; ++k) {
+        const Prim& q = prims[pairs[k].prim];
+        int lo[3], hi[3];
+        for (int a = 0; a < 3; ++a) {
+          lo[a] = std::max(origin[a], int(std::ceil((q.box.min[a] - g.band) / g.h)));
+          hi[a] = std::min(origin[a] + 7, int(std::floor((q.box.max[a] + g.band) / g.h)));
         }
-        const openvdb::Coord origin = unpack_leaf_origin(pairs[begin].leaf);
-        std::fill(values, values + 512, band);
-        for (size_t k = begin; k < end; ++k) {
-          const Prim& q = prims[pairs[k].prim];
-          int lo[3], hi[3];
-          for (int a = 0; a < 3; ++a) {
-            lo[a] = std::max(origin[a], int(std::ceil((q.box.min[a] - g.band) / g.h)));
-            hi[a] = std::min(origin[a] + 7, int(std::floor((q.box.max[a] + g.band) / g.h)));
-          }
-          for (int x = lo[0]; x <= hi[0]; ++x) {
-            for (int y = lo[1]; y <= hi[1]; ++y) {
-              float* row = values + ((x - origin[0]) << 6) + ((y - origin[1]) << 3);
-              for (int z = lo[2]; z <= hi[2]; ++z) {
-                double d = distance(q, Vec3d{x * g.h, y * g.h, z * g.h});
-                float f = static_cast<float>(d);
-                float& v = row[z - origin[2]];
-                if (f < v) v = f;
-              }
+        for (int x = lo[0]; x <= hi[0]; ++x) {
+          for (int y = lo[1]; y <= hi[1]; ++y) {
+            float* row = values + ((x - origin[0]) << 6) + ((y - origin[1]) << 3);
+            for (int z = lo[2]; z <= hi[2]; ++z) {
+              float f = static_cast<float>(distance(q, planes, Vec3d{x * g.h, y * g.h, z * g.h}));
+              float& v = row[z - origin[2]];
+              if (f < v) v = f;
             }
           }
         }
-        bool any_active = false, all_negative = true;
-        for (float v : values) {
-          if (std::fabs(v) < band) any_active = true;
-          if (v > -band) all_negative = false;
-        }
-        if (!any_active) {
-          if (all_negative) interior[li] = 1;
-          continue;
-        }
-        auto* leaf = new LeafT(origin, band, false);
-        for (openvdb::Index n = 0; n < 512; ++n) {
-          float v = values[n];
-          if (std::fabs(v) < band) leaf->setValueOn(n, v);
-          else leaf->setValueOff(n, v < 0 ? -band : band);
-        }
-        leaves[li] = leaf;
       }
-      progress.advance(r.size() * prims.size() / std::max<size_t>(1, leaf_count));
-    });
-
-    // 3. Into the tree (serial: the tree is not thread-safe for insertion), then collapse the
-    // interior into large tiles.
-    openvdb::FloatTree& tree = grid->tree();
-    for (size_t li = 0; li < leaf_count; ++li) {
-      if (leaves[li]) tree.addLeaf(leaves[li]);
-      else if (interior[li]) tree.addTile(1, unpack_leaf_origin(pairs[starts[li]].leaf), -band, false);
+      bool any_active = false, all_negative = true;
+      for (float v : values) {
+        if (std::fabs(v) < band) any_active = true;
+        if (v > -band) all_negative = false;
+      }
+      if (!any_active) {
+        if (all_negative) interior[li] = 1;
+        continue;
+      }
+      auto leaf = std::make_unique<LeafT>(origin, band, false);
+      for (openvdb::Index n = 0; n < 512; ++n) {
+        float v = values[n];
+        if (std::fabs(v) < band) leaf->setValueOn(n, v);
+        else leaf->setValueOff(n, v < 0 ? -band : band);
+      }
+      leaves[li] = std::move(leaf);
     }
+    progress.advance(r.size() * prims.size() / std::max<size_t>(1, leaf_count));
+  });
+
+  // 3. Into the grid, as the minimum with what earlier batches put there. The tree is not
+  // thread-safe for insertion, so new leaves and tiles go in serially; leaves that already
+  // exist are merged in parallel.
+  openvdb::FloatTree& tree = impl_->grid->tree();
+  std::vector<std::pair<LeafT*, LeafT*>> merges;  // (existing, new)
+  for (size_t li = 0; li < leaf_count; ++li) {
+    const openvdb::Coord origin = unpack_leaf_origin(pairs[starts[li]].leaf);
+    if (interior[li]) {
+      tree.addTile(1, origin, -band, false);
+      continue;
+    }
+    if (!leaves[li]) continue;
+    if (LeafT* existing = tree.probeLeaf(origin)) {
+      merges.emplace_back(existing, leaves[li].get());
+    } else if (tree.getValue(origin) > 0) {
+      tree.addLeaf(leaves[li].release());
+    }
+    // else: inside an interior tile from an earlier batch; nothing to add.
   }
-  openvdb::tools::pruneLevelSet(grid->tree());
-  return wrap_grid(grid, options);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, merges.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i != r.end(); ++i) {
+      LeafT& old_leaf = *merges[i].first;
+      const LeafT& new_leaf = *merges[i].second;
+      for (openvdb::Index n = 0; n < 512; ++n) {
+        float v = std::min(old_leaf.getValue(n), new_leaf.getValue(n));
+        if (std::fabs(v) < band) old_leaf.setValueOn(n, v);
+        else old_leaf.setValueOff(n, v < 0 ? -band : band);
+      }
+    }
+  });
+}
+
+Volume PrimitiveRasterizer::finish() {
+  openvdb::tools::pruneLevelSet(impl_->grid->tree());
+  Volume v = wrap_grid(impl_->grid, impl_->options);
+  impl_->grid = make_level_set_grid(impl_->options);
+  return v;
+}
+
+Volume rasterize_primitives(const GeometrySet& set, const VolumeOptions& options) {
+  PrimitiveRasterizer rasterizer(options);
+  rasterizer.add(set);
+  return rasterizer.finish();
 }
 
 }  // namespace lacuna

@@ -4,6 +4,8 @@
 // triangle soup and meshToLevelSet is ~20x slower and less accurate.
 #pragma once
 
+#include <memory>
+
 #include "geometry.h"
 #include "solids/volume.h"
 
@@ -12,6 +14,25 @@ namespace lacuna {
 // Number of distance primitives (round cones, spheres, shapes, triangles) in the set's analytic
 // part (tubes, spheres, shapes, surfaces).
 size_t primitive_count(const GeometrySet& set);
+
+// Builds one level set from primitives handed over in batches: each batch is rasterized and
+// merged into the grid as a minimum, so a generator with millions of pieces never holds them all.
+class PrimitiveRasterizer {
+ public:
+  explicit PrimitiveRasterizer(const VolumeOptions& options);
+  ~PrimitiveRasterizer();
+  PrimitiveRasterizer(const PrimitiveRasterizer&) = delete;
+  PrimitiveRasterizer& operator=(const PrimitiveRasterizer&) = delete;
+
+  // Adds the batch's analytic pieces (tubes, spheres, shapes, surfaces, cells); others ignored.
+  void add(const GeometrySet& batch);
+  // The level set of everything added; the rasterizer starts over empty.
+  Volume finish();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 // Rasterizes the union of the set's analytic part into one level set with exact distances in
 // the narrow band; closed meshes and regions are ignored here (see voxelize()). The set must

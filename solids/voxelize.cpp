@@ -47,6 +47,19 @@ double surface_area_bound_mm2(const GeometrySet& set) {
   }
   for (const ThickSurface& s : set.surfaces) area += 2 * surface_area(s.surface);
   for (const TriMesh& m : set.solids) area += surface_area(m);
+  for (const ConvexCells& cells : set.cells) {
+    const size_t m = size_t(cells.corners_per_cell);
+    for (size_t c = 0; c < cells.size(); ++c) {
+      const Vec3d* v = cells.corners_mm.data() + c * m;
+      for (const auto& face : cells.faces) {
+        Vec3d n{0, 0, 0};
+        for (size_t i = 0; i < face.size(); ++i) n += cross(v[face[i]], v[face[(i + 1) % face.size()]]);
+        area += 0.5 * norm(n);
+      }
+    }
+  }
+  for (const GeometryStream& stream : set.streams)
+    stream.emit([&](const GeometrySet& batch) { area += surface_area_bound_mm2(batch); });
   for (const Region2& r : set.regions) {
     double perimeter = 0;
     for (const auto& loop : r.loops_mm)
@@ -87,6 +100,10 @@ Box3 bounding_box(const GeometrySet& set) {
   for (const ThickSurface& ts : set.surfaces)
     for (const Vec3d& p : ts.surface.positions_mm) ball(p, 0.5 * ts.thickness_mm);
   for (const TriMesh& m : set.solids) box.expand(lacuna::bounding_box(m));
+  for (const ConvexCells& cells : set.cells)
+    for (const Vec3d& p : cells.corners_mm) box.expand(p);
+  for (const GeometryStream& stream : set.streams)
+    stream.emit([&](const GeometrySet& batch) { box.expand(bounding_box(batch)); });
   for (const Region2& r : set.regions) {
     Vec3d n = cross(r.axis_u, r.axis_v);
     for (const auto& loop : r.loops_mm)
@@ -159,6 +176,21 @@ void validate(const GeometrySet& set) {
       for (uint32_t v : t)
         if (v >= m.positions_mm.size()) fail("solid mesh " + std::to_string(i) + ": triangle index out of range");
   }
+  for (size_t i = 0; i < set.cells.size(); ++i) {
+    const ConvexCells& cells = set.cells[i];
+    const std::string where = "cells " + std::to_string(i);
+    if (cells.corners_per_cell < 4) fail(where + ": a cell needs at least 4 corners");
+    if (cells.corners_mm.size() % size_t(cells.corners_per_cell) != 0)
+      fail(where + ": the corner list is not a whole number of cells");
+    if (cells.faces.size() < 4) fail(where + ": a cell needs at least 4 faces");
+    for (const auto& face : cells.faces) {
+      if (face.size() < 3) fail(where + ": a face needs at least 3 corners");
+      for (int c : face)
+        if (c < 0 || c >= cells.corners_per_cell) fail(where + ": a face names corner " + std::to_string(c));
+    }
+    for (const Vec3d& p : cells.corners_mm)
+      if (!is_finite(p)) fail(where + ": has a non-finite corner");
+  }
   for (size_t i = 0; i < set.regions.size(); ++i) {
     const Region2& r = set.regions[i];
     std::string where = "region " + std::to_string(i);
@@ -178,7 +210,14 @@ void validate(const GeometrySet& set) {
 
 Volume voxelize(const GeometrySet& set, const VolumeOptions& options) {
   validate(set);
-  Volume result = rasterize_primitives(set, options);
+  PrimitiveRasterizer rasterizer(options);
+  rasterizer.add(set);
+  for (const GeometryStream& stream : set.streams)
+    stream.emit([&](const GeometrySet& batch) {
+      validate(batch);
+      rasterizer.add(batch);
+    });
+  Volume result = rasterizer.finish();
   for (const TriMesh& m : set.solids) result = unite(result, mesh_to_volume(m, options));
   for (const Region2& r : set.regions) result = unite(result, mesh_to_volume(extrude_region(r), options));
   return result;

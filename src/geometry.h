@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -110,6 +111,23 @@ struct ThickSurface {
   double thickness_mm = 1.0;
 };
 
+// Convex polyhedra sharing one face layout (all hexahedra, all tetrahedra, ...): the cells of a
+// volume attractor. Faces list corner indices; their orientation is not trusted (mirrored cells
+// are common), the solid stage orients them from the cell's centroid.
+struct ConvexCells {
+  int corners_per_cell = 8;
+  std::vector<std::vector<int>> faces;  // indices 0 .. corners_per_cell - 1
+  std::vector<Vec3d> corners_mm;        // corners_per_cell per cell, cell after cell
+  size_t size() const { return corners_per_cell > 0 ? corners_mm.size() / size_t(corners_per_cell) : 0; }
+};
+
+struct GeometrySet;
+// A source that hands its pieces over in batches, so that millions of them are never all in
+// memory: emit() calls the sink once per batch, the same batches every time it is called.
+struct GeometryStream {
+  std::function<void(const std::function<void(const GeometrySet&)>& sink)> emit;
+};
+
 // What a generator or a recipe input hands to the solid stage: a union of pieces of any kind.
 struct GeometrySet {
   TubeSet tubes;
@@ -118,6 +136,8 @@ struct GeometrySet {
   std::vector<ThickSurface> surfaces;
   std::vector<TriMesh> solids;      // closed meshes, each bounding a solid
   std::vector<Region2> regions;     // extruded planar regions
+  std::vector<ConvexCells> cells;   // convex polyhedra
+  std::vector<GeometryStream> streams;  // batches of any of the above (streams inside ignored)
 };
 
 // Mesh statistics that depend only on the triangle list.
