@@ -234,6 +234,75 @@ TEST(Cli, RefusesBeyondTheMemoryBudgetBeforeAllocating) {
   EXPECT_EQ(huge.code, 3) << huge.err;
   EXPECT_LT(huge.seconds, 5.0);
   EXPECT_FALSE(fs::exists(dir / "huge"));
+
+  // 20^9 Menger cubes: refused from the piece count before any is made.
+  write_file(dir / "sponge.json", R"({"voxel_size_mm": 0.1,
+    "inputs": {"s": {"type": "cifs", "system": "menger_sponge", "level": 9}},
+    "outputs": [{"of": "s", "file": "s.stl"}]})");
+  Result sponge = lacuna("run " + quote((dir / "sponge.json").string()) + " -o " + quote((dir / "s").string()), dir.path());
+  EXPECT_EQ(sponge.code, 3) << sponge.err;
+  EXPECT_NE(sponge.err.find("inputs.s: level 9 has 512000000000 pieces"), std::string::npos) << sponge.err;
+}
+
+// --- CIFS and NURBS inspection -------------------------------------------------------------------
+
+TEST(Cli, CifsAndNurbsInspection) {
+  TempDir dir;
+  Result automaton = lacuna("nurbs automaton --degree 3 --knots 0,0.5,1.7,2.0,3.1,3.3 --json", dir.path());
+  ASSERT_EQ(automaton.code, 0) << automaton.err;
+  nlohmann::json a = nlohmann::json::parse(automaton.out);
+  ASSERT_EQ(a["states"].size(), 8u);  // 4 (d - 1) windows
+  int stationary = 0;
+  for (const auto& st : a["states"]) stationary += st["stationary"].get<bool>();
+  EXPECT_EQ(stationary, 3);
+  const double window[] = {0.5, 1.2, 0.3, 1.1, 0.2};  // the inter-nodes of the knots given
+  for (size_t k = 0; k < 5; ++k) EXPECT_NEAR(a["states"][0]["window"][k].get<double>(), window[k], 1e-12);
+  for (const auto& st : a["states"])
+    for (const char* side : {"L", "R"})
+      for (size_t c = 0; c < 4; ++c) {
+        double sum = 0;
+        for (size_t r = 0; r < 4; ++r) sum += st["transitions"][side]["matrix"][r][c].get<double>();
+        EXPECT_NEAR(sum, 1.0, 1e-12);
+      }
+
+  write_file(dir / "points.json", "[[0, 0, 0], [1, 2, 0], [2, 0, 0]]");
+  Result points = lacuna("nurbs tessellate --degree 2 --knots 0,1,2,3 --control-points " +
+                             quote((dir / "points.json").string()) + " --level 4 --json",
+                         dir.path());
+  ASSERT_EQ(points.code, 0) << points.err;
+  nlohmann::json p = nlohmann::json::parse(points.out);
+  ASSERT_EQ(p["points"].size(), 17u);
+  // The uniform quadratic piece runs from the middle of the first leg to the middle of the last,
+  // and passes through (1, 1) at its middle: (1/8)(0,0) + (3/4)(1,2) + (1/8)(2,0).
+  EXPECT_NEAR(p["points"][0][0].get<double>(), 0.5, 1e-14);
+  EXPECT_NEAR(p["points"][0][1].get<double>(), 1.0, 1e-14);
+  EXPECT_NEAR(p["points"][8][0].get<double>(), 1.0, 1e-14);
+  EXPECT_NEAR(p["points"][8][1].get<double>(), 1.5, 1e-14);
+  EXPECT_NEAR(p["points"][16][0].get<double>(), 1.5, 1e-14);
+
+  Result info = lacuna("cifs info menger_sponge --json", dir.path());
+  ASSERT_EQ(info.code, 0) << info.err;
+  nlohmann::json i = nlohmann::json::parse(info.out);
+  EXPECT_EQ(i["states"].size(), 1u);
+  EXPECT_EQ(i["transitions"].size(), 20u);
+  EXPECT_TRUE(i["states"][0]["stationary"].get<bool>());
+
+  Result koch = lacuna("cifs tessellate koch_curve --level 2 --format json", dir.path());
+  ASSERT_EQ(koch.code, 0) << koch.err;
+  EXPECT_EQ(nlohmann::json::parse(koch.out)["points"].size(), 17u);
+  Result csv = lacuna("cifs tessellate koch_curve --level 2 --format csv", dir.path());
+  EXPECT_EQ(std::count(csv.out.begin(), csv.out.end(), '\n'), 18);
+  Result obj = lacuna("cifs tessellate sierpinski_tetrahedron --level 1 --format obj", dir.path());
+  EXPECT_EQ(std::count(obj.out.begin(), obj.out.end(), 'f'), 16);  // 4 tetrahedra x 4 faces
+
+  EXPECT_EQ(lacuna("cifs info menger_spnge", dir.path()).code, 2);
+  EXPECT_EQ(lacuna("nurbs automaton --degree 2 --knots 0,x,2,3", dir.path()).code, 2);
+  EXPECT_EQ(lacuna("nurbs automaton --degree 2 --knots 0,1,2", dir.path()).code, 2);
+  write_file(dir / "two.json", "[[0, 0, 0], [1, 2, 0]]");
+  Result few = lacuna("nurbs tessellate --degree 2 --knots 0,1,2,3 --control-points " + quote((dir / "two.json").string()),
+                      dir.path());
+  EXPECT_EQ(few.code, 2);
+  EXPECT_NE(few.err.find("two.json"), std::string::npos) << few.err;
 }
 
 // --- malformed input ---------------------------------------------------------------------------
@@ -335,6 +404,13 @@ std::vector<BadCase> bad_cases() {
       {"future_format", R"({"lacuna_recipe": 2, "inputs": {"x": )" + ok_input + R"(}, "outputs": [{"of": "x", "file": "x.stl"}]})", "", "", "format 1"},
       {"bad_name", R"({"inputs": {"a b": )" + ok_input + R"(}, "outputs": [{"of": "a b", "file": "x.stl"}]})", "", "", "names use"},
       {"negative_seed", R"({"seed": -3, "inputs": {"x": )" + ok_input + R"(}, "outputs": [{"of": "x", "file": "x.stl"}]})", "", "", "seed"},
+      {"cifs_unknown_system", with_input(R"({"type": "cifs", "system": "menger_spunge", "level": 2})"), "", "", "did you mean \"menger_sponge\""},
+      {"cifs_level_too_high", with_input(R"({"type": "cifs", "system": "menger_sponge", "level": 30})"), "", "", "inputs.x.level"},
+      {"cifs_bad_as", with_input(R"({"type": "cifs", "system": "koch_curve", "as": "tube", "radius_mm": 1})"), "", "", "\"tubes\""},
+      {"cifs_tubes_without_radius", with_input(R"({"type": "cifs", "system": "koch_curve", "level": 2})"), "", "", "radius_mm"},
+      {"cifs_knot_count", with_input(R"({"type": "cifs", "system": {"nurbs_curve": {"degree": 3, "knots": [0, 1, 2]}, "control_points_mm": [[0,0,0],[1,0,0],[2,0,0],[3,0,0]]}, "radius_mm": 1})"), "", "", "needs 6 knots"},
+      {"cifs_point_count", with_input(R"({"type": "cifs", "system": {"nurbs_curve": {"degree": 2, "knots": [0, 1, 2, 3]}, "control_points_mm": [[0,0,0],[1,0,0]]}, "radius_mm": 1})"), "", "", "expected 3 control points"},
+      {"cifs_matrix_not_barycentric", with_input(R"({"type": "cifs", "system": {"states": [{"name": "s", "control_points": 2}], "transitions": [{"from": "s", "symbol": 0, "to": "s", "matrix": [[1, 0.5], [0, 0.4]]}], "control_points_mm": [[0,0,0],[1,0,0]]}, "radius_mm": 1})"), "", "", "expected 1 (barycentric)"},
       {"empty_result", R"({"inputs": {"a": {"type": "sphere", "radius_mm": 1}, "b": {"type": "sphere", "center_mm": [9, 0, 0], "radius_mm": 1}}, "operations": [{"name": "i", "op": "intersection", "of": ["a", "b"]}], "outputs": [{"of": "i", "file": "x.stl"}]})", "", "", "empty"},
   };
 }

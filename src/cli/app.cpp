@@ -9,6 +9,7 @@
 #include <memory>
 #include <new>
 
+#include "cli/cifs_commands.h"
 #include "cli/run_recipe.h"
 #include "errors.h"
 #include "export/mesh_io.h"
@@ -97,6 +98,7 @@ int run_app(int argc, char** argv) {
                "free of self-intersections and degenerate faces, positive volume. Exit 0 only if valid.");
   check->add_option("MESH", mesh_path, "Mesh file")->required();
   add_common(check, flags);
+  std::function<int()> cifs_command = add_cifs_commands(app);
 
   try {
     app.parse(argc, argv);
@@ -114,7 +116,8 @@ int run_app(int argc, char** argv) {
       run_options.max_memory_bytes = uint64_t(max_memory_gb * 1e9);
       return command_run(recipe, run_options, flags);
     }
-    return command_check(mesh_path, flags);
+    if (*check) return command_check(mesh_path, flags);
+    return cifs_command();
   } catch (const Error& e) {
     std::cerr << "lacuna: error: " << e.what() << "\n";
     return e.exit_code();

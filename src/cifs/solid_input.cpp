@@ -1,0 +1,171 @@
+#include "cifs/solid_input.h"
+
+#include <memory>
+#include <set>
+#include <string>
+
+#include "cifs/library.h"
+#include "cifs/tessellate.h"
+#include "errors.h"
+#include "recipe/recipe.h"
+
+namespace lacuna {
+namespace cifs {
+namespace {
+
+constexpr uint64_t kMaxPieces = 500'000'000;
+
+Vec3d column(const Eigen::Matrix3Xd& v, Eigen::Index i) { return Vec3d{v(0, i), v(1, i), v(2, i)}; }
+
+// Edges (pairs of vertex indices) of a primitive with `m` vertices: segments and polygons along
+// their outline, polyhedra along their faces, each edge once.
+std::vector<std::pair<int, int>> primitive_edges(const State& s) {
+  std::set<std::pair<int, int>> edges;
+  const int m = int(s.vertices.cols());
+  auto loop = [&](const std::vector<int>& face) {
+    for (size_t i = 0; i < face.size(); ++i) {
+      int a = face[i], b = face[(i + 1) % face.size()];
+      edges.insert({std::min(a, b), std::max(a, b)});
+    }
+  };
+  if (primitive_dimension(s.primitive) == 3) {
+    for (const auto& face : primitive_faces(s)) loop(face);
+  } else if (primitive_dimension(s.primitive) == 1) {
+    edges.insert({0, m - 1});
+  } else {
+    std::vector<int> outline;
+    for (int i = 0; i < m; ++i) outline.push_back(i);
+    loop(s.faces.empty() ? outline : s.faces.front());
+  }
+  return {edges.begin(), edges.end()};
+}
+
+}  // namespace
+
+GeometrySet attractor_geometry(const Cifs& cifs_in, int level, const SolidOptions& options) {
+  auto c = std::make_shared<Cifs>(cifs_in);
+  complete_primitives(c->automaton);
+  const uint64_t pieces = count_pieces(c->automaton, level);
+  if (pieces > kMaxPieces)
+    throw ResourceLimit("level " + std::to_string(level) + " has " + std::to_string(pieces) + " pieces, more than " +
+                        std::to_string(kMaxPieces) + "; use a lower level");
+  int dimension = -1;
+  for (const State& s : c->automaton.states) {
+    int d = primitive_dimension(s.primitive);
+    if (dimension >= 0 && d != dimension && options.as != SolidOptions::As::kEdges)
+      throw InvalidInput("the system mixes primitives of different dimensions; use \"as\": \"edges\"");
+    dimension = std::max(dimension, d);
+  }
+  SolidOptions::As as = options.as;
+  if (as == SolidOptions::As::kDefault)
+    as = dimension == 1 ? SolidOptions::As::kTubes : dimension == 2 ? SolidOptions::As::kShell : SolidOptions::As::kCells;
+  if (as == SolidOptions::As::kTubes && dimension != 1) throw InvalidInput("\"tubes\" needs a curve system; use \"edges\"");
+  if (as == SolidOptions::As::kShell && dimension != 2) throw InvalidInput("\"shell\" needs a surface system");
+  if (as == SolidOptions::As::kCells && dimension != 3) throw InvalidInput("\"cells\" needs a volume system");
+  if ((as == SolidOptions::As::kTubes || as == SolidOptions::As::kEdges) && !(options.radius_mm > 0))
+    throw InvalidInput("tubes need a positive \"radius_mm\"");
+  if (as == SolidOptions::As::kShell && !(options.thickness_mm > 0))
+    throw InvalidInput("a shell needs a positive \"thickness_mm\"");
+  const size_t batch = std::max<size_t>(options.batch_pieces, 1);
+
+  GeometryStream stream;
+  switch (as) {
+    case SolidOptions::As::kCells:
+      stream.emit = [c, level, batch](const std::function<void(const GeometrySet&)>& sink) {
+        tessellate_cells(*c, level, batch, [&](const ConvexCells& cells) {
+          GeometrySet set;
+          set.cells.push_back(cells);
+          sink(set);
+        });
+      };
+      break;
+    case SolidOptions::As::kTubes: {
+      // Consecutive pieces share their end points, so a curve split between batches stays whole.
+      const double radius = options.radius_mm;
+      stream.emit = [c, level, batch, radius](const std::function<void(const GeometrySet&)>& sink) {
+        GeometrySet set;
+        size_t count = 0;
+        for (auto& line : tessellate_curves(*c, level)) {
+          for (size_t i = 0; i < line.size(); i += batch) {
+            size_t end = std::min(line.size(), i + batch + 1);
+            set.tubes.tubes.push_back(Tube{std::vector<Vec3d>(line.begin() + long(i), line.begin() + long(end)), {radius}});
+            count += end - i;
+            if (count >= batch) {
+              sink(set);
+              set = GeometrySet();
+              count = 0;
+            }
+          }
+        }
+        if (!set.tubes.tubes.empty()) sink(set);
+      };
+      break;
+    }
+    case SolidOptions::As::kShell:
+    case SolidOptions::As::kEdges: {
+      const bool shell = as == SolidOptions::As::kShell;
+      const double size = shell ? options.thickness_mm : options.radius_mm;
+      auto edges = std::make_shared<std::vector<std::vector<std::pair<int, int>>>>();
+      for (const State& s : c->automaton.states) edges->push_back(primitive_edges(s));
+      stream.emit = [c, level, batch, shell, size, edges](const std::function<void(const GeometrySet&)>& sink) {
+        GeometrySet set;
+        size_t count = 0;
+        for_each_piece(*c, level, [&](const Piece& piece) {
+          const Eigen::Matrix3Xd& v = *piece.vertices;
+          if (shell) {
+            ThickSurface& s = set.surfaces.empty() ? set.surfaces.emplace_back(ThickSurface{TriMesh{}, size})
+                                                   : set.surfaces.back();
+            uint32_t base = uint32_t(s.surface.positions_mm.size());
+            for (Eigen::Index i = 0; i < v.cols(); ++i) s.surface.positions_mm.push_back(column(v, i));
+            for (uint32_t i = 1; i + 1 < uint32_t(v.cols()); ++i) s.surface.triangles.push_back({base, base + i, base + i + 1});
+          } else {
+            for (const auto& [a, b] : (*edges)[size_t(piece.state)])
+              set.tubes.tubes.push_back(Tube{{column(v, a), column(v, b)}, {size}});
+          }
+          if (++count >= batch) {
+            sink(set);
+            set = GeometrySet();
+            count = 0;
+          }
+        });
+        if (count > 0) sink(set);
+      };
+      break;
+    }
+    case SolidOptions::As::kDefault:
+      break;
+  }
+  GeometrySet out;
+  out.streams.push_back(std::move(stream));
+  return out;
+}
+
+void register_recipe_inputs() {
+  register_input_type(
+      {"cifs",
+       {"system", "level", "as", "radius_mm", "thickness_mm"},
+       [](const JsonObject& o, RecipeInput& in) {
+         Cifs c = parse_system(o.required("system"), o.file(), o.path_of("system"));
+         uint64_t level = o.unsigned_integer_or("level", 3);
+         if (level > 24) o.fail("level", "expected a level from 0 to 24");
+         SolidOptions options;
+         std::string as = o.string_or("as", "");
+         if (as == "tubes") options.as = SolidOptions::As::kTubes;
+         else if (as == "shell") options.as = SolidOptions::As::kShell;
+         else if (as == "cells") options.as = SolidOptions::As::kCells;
+         else if (as == "edges") options.as = SolidOptions::As::kEdges;
+         else if (!as.empty()) o.fail("as", "expected \"tubes\", \"shell\", \"cells\" or \"edges\", got \"" + as + "\"");
+         if (o.has("radius_mm")) options.radius_mm = o.positive_length("radius_mm");
+         if (o.has("thickness_mm")) options.thickness_mm = o.positive_length("thickness_mm");
+         try {
+           in.geometry = attractor_geometry(c, int(level), options);
+         } catch (const InvalidInput& e) {
+           o.fail("", e.what());
+         } catch (const ResourceLimit& e) {
+           throw ResourceLimit(o.file() + ": " + o.path() + ": " + e.what());
+         }
+       }});
+}
+
+}  // namespace cifs
+}  // namespace lacuna

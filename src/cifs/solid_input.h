@@ -1,0 +1,29 @@
+// CIFS attractors as recipe inputs: curves as tubes, surfaces as shells, volumes as cells, any of
+// them as the edges of their pieces; pieces streamed to the solid stage in batches.
+#pragma once
+
+#include <cstddef>
+
+#include "cifs/automaton.h"
+#include "geometry.h"
+
+namespace lacuna {
+namespace cifs {
+
+struct SolidOptions {
+  enum class As { kDefault, kTubes, kShell, kCells, kEdges };
+  As as = As::kDefault;         // default: curves -> tubes, surfaces -> shell, volumes -> cells
+  double radius_mm = 0;         // tubes and edges
+  double thickness_mm = 0;      // shells
+  size_t batch_pieces = 65536;  // pieces per batch handed to the rasterizer
+};
+
+// The geometry of level `level` as a stream of batches (nothing is generated until it is read).
+// Throws InvalidInput when the options do not fit the system's primitives.
+GeometrySet attractor_geometry(const Cifs& cifs, int level, const SolidOptions& options);
+
+// Registers the "cifs" recipe input type (called once by the recipe reader).
+void register_recipe_inputs();
+
+}  // namespace cifs
+}  // namespace lacuna

@@ -1,0 +1,249 @@
+#include "cli/cifs_commands.h"
+
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "cifs/library.h"
+#include "cifs/nurbs.h"
+#include "cifs/tessellate.h"
+#include "errors.h"
+#include "recipe/json_fields.h"
+
+namespace lacuna {
+namespace {
+
+struct CifsArgs {
+  std::string system;
+  int level = 3;
+  std::string format = "json";
+  bool json = false;
+};
+
+struct NurbsArgs {
+  int degree = 2;
+  std::string knots;
+  std::string control_points;
+  int level = 4;
+  bool json = false;
+};
+
+std::vector<double> parse_knots(const std::string& text) {
+  std::vector<double> knots;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    try {
+      size_t used = 0;
+      double v = std::stod(item, &used);
+      if (used != item.size() && item.find_first_not_of(" ", used) != std::string::npos) throw std::invalid_argument(item);
+      knots.push_back(v);
+    } catch (const std::exception&) {
+      throw InvalidInput("--knots: \"" + item + "\" is not a number (expected t0,t1,...)");
+    }
+  }
+  return knots;
+}
+
+nlohmann::json point_json(const Vec3d& p) { return {p.x, p.y, p.z}; }
+
+int cifs_info(const CifsArgs& args) {
+  cifs::Cifs c = cifs::load_system(args.system);
+  cifs::complete_primitives(c.automaton);
+  nlohmann::json j = cifs::system_json(c);
+  if (args.json) {
+    std::cout << j.dump(2) << "\n";
+    return kExitOk;
+  }
+  std::printf("%s: %zu state%s, alphabet of %d, initial state %d%s\n", c.name.c_str(), c.automaton.states.size(),
+              c.automaton.states.size() == 1 ? "" : "s", c.automaton.alphabet_size, c.automaton.initial,
+              c.rational ? ", rational" : "");
+  for (const auto& s : j["states"]) {
+    std::printf("  state %d %s: %d control points, %s%s\n", s["index"].get<int>(), s["name"].get<std::string>().c_str(),
+                s["control_points"].get<int>(), s["primitive"].get<std::string>().c_str(),
+                s["stationary"].get<bool>() ? ", stationary" : "");
+    for (const auto& f : s["fixed_points"]) std::printf("    fixed point of symbol %d: %s\n", f["symbol"].get<int>(), f["barycentric"].dump().c_str());
+  }
+  for (const auto& t : j["transitions"])
+    std::printf("  %d --%d--> %d\n", t["from"].get<int>(), t["symbol"].get<int>(), t["to"].get<int>());
+  return kExitOk;
+}
+
+int cifs_tessellate(const CifsArgs& args) {
+  if (args.format != "json" && args.format != "csv" && args.format != "obj")
+    throw InvalidInput("--format: expected json, csv or obj, got \"" + args.format + "\"");
+  cifs::Cifs c = cifs::load_system(args.system);
+  cifs::complete_primitives(c.automaton);
+  const uint64_t pieces = cifs::count_pieces(c.automaton, args.level);
+  if (pieces > 20'000'000)
+    throw ResourceLimit("level " + std::to_string(args.level) + " has " + std::to_string(pieces) +
+                        " pieces; printing more than 20 000 000 is refused, use a recipe to build the solid");
+  const int dimension = cifs::primitive_dimension(c.automaton.states[size_t(c.automaton.initial)].primitive);
+  std::vector<Vec3d> points;
+  std::vector<std::vector<uint32_t>> cells;  // polylines, triangles or cells as vertex lists
+  std::vector<std::vector<uint32_t>> faces;  // for obj: the faces of the cells
+  if (dimension == 1) {
+    for (const auto& line : cifs::tessellate_curves(c, args.level)) {
+      std::vector<uint32_t> ids;
+      for (const Vec3d& p : line) {
+        ids.push_back(uint32_t(points.size()));
+        points.push_back(p);
+      }
+      cells.push_back(ids);
+    }
+  } else if (dimension == 2) {
+    TriMesh mesh = cifs::tessellate_surface(c, args.level);
+    points = mesh.positions_mm;
+    for (const auto& t : mesh.triangles) cells.push_back({t[0], t[1], t[2]});
+  } else {
+    cifs::for_each_piece(c, args.level, [&](const cifs::Piece& piece) {
+      std::vector<uint32_t> ids;
+      for (Eigen::Index i = 0; i < piece.vertices->cols(); ++i) {
+        ids.push_back(uint32_t(points.size()));
+        points.push_back(Vec3d{(*piece.vertices)(0, i), (*piece.vertices)(1, i), (*piece.vertices)(2, i)});
+      }
+      for (const auto& face : cifs::primitive_faces(c.automaton.states[size_t(piece.state)])) {
+        std::vector<uint32_t> f;
+        for (int k : face) f.push_back(ids[size_t(k)]);
+        faces.push_back(f);
+      }
+      cells.push_back(ids);
+    });
+  }
+  if (args.format == "json") {
+    nlohmann::json j = {{"system", c.name}, {"level", args.level}, {"pieces", pieces}, {"points", nlohmann::json::array()}};
+    for (const Vec3d& p : points) j["points"].push_back(point_json(p));
+    const char* key = dimension == 1 ? "polylines" : dimension == 2 ? "triangles" : "cells";
+    j[key] = cells;
+    std::cout << j.dump() << "\n";
+  } else if (args.format == "csv") {
+    std::cout << "x,y,z\n";
+    char line[128];
+    for (const Vec3d& p : points) {
+      std::snprintf(line, sizeof line, "%.17g,%.17g,%.17g\n", p.x, p.y, p.z);
+      std::cout << line;
+    }
+  } else {
+    char line[128];
+    for (const Vec3d& p : points) {
+      std::snprintf(line, sizeof line, "v %.17g %.17g %.17g\n", p.x, p.y, p.z);
+      std::cout << line;
+    }
+    for (const auto& cell : dimension == 3 ? faces : cells) {
+      std::cout << (dimension == 1 ? "l" : "f");
+      for (uint32_t id : cell) std::cout << " " << id + 1;
+      std::cout << "\n";
+    }
+  }
+  return kExitOk;
+}
+
+nlohmann::json matrix_json(const Eigen::MatrixXd& m) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (Eigen::Index i = 0; i < m.rows(); ++i) {
+    nlohmann::json row = nlohmann::json::array();
+    for (Eigen::Index j = 0; j < m.cols(); ++j) row.push_back(m(i, j));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+int nurbs_automaton_command(const NurbsArgs& args) {
+  cifs::NurbsAutomaton na = cifs::nurbs_automaton(args.degree, parse_knots(args.knots));
+  std::vector<int> stationary = cifs::stationary_states(na.automaton);
+  nlohmann::json states = nlohmann::json::array();
+  for (size_t q = 0; q < na.windows.size(); ++q) {
+    nlohmann::json transitions = nlohmann::json::object();
+    for (const cifs::Transition& t : na.automaton.transitions[q])
+      transitions[t.symbol == 0 ? "L" : "R"] = {{"to", t.target}, {"matrix", matrix_json(t.matrix)}};
+    states.push_back({{"index", q},
+                      {"window", na.windows[q]},
+                      {"stationary", std::find(stationary.begin(), stationary.end(), int(q)) != stationary.end()},
+                      {"transitions", transitions}});
+  }
+  if (args.json) {
+    std::cout << nlohmann::json{{"degree", args.degree}, {"states", states}}.dump(2) << "\n";
+    return kExitOk;
+  }
+  std::printf("degree %d: %zu states, %zu stationary\n", args.degree, na.windows.size(), stationary.size());
+  for (const auto& s : states)
+    std::printf("  state %d window %s%s: L -> %d, R -> %d\n", s["index"].get<int>(), s["window"].dump().c_str(),
+                s["stationary"].get<bool>() ? " (stationary)" : "", s["transitions"]["L"]["to"].get<int>(),
+                s["transitions"]["R"]["to"].get<int>());
+  return kExitOk;
+}
+
+int nurbs_tessellate_command(const NurbsArgs& args) {
+  std::vector<double> knots = parse_knots(args.knots);
+  std::ifstream in(args.control_points, std::ios::binary);
+  if (!in) throw IoError(args.control_points + ": cannot open the control points file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  nlohmann::json points = parse_json_text(text.str(), args.control_points);
+  // Through the system reader, which checks the knots and the points.
+  nlohmann::json system = {{"nurbs_curve", {{"degree", args.degree}, {"knots", knots}}}, {"control_points_mm", points}};
+  cifs::Cifs c = cifs::parse_system(system, args.control_points, "");
+  if (args.level < 0 || args.level > 24) throw InvalidInput("--level: expected 0 .. 24");
+  std::vector<std::vector<Vec3d>> lines = cifs::tessellate_curves(c, args.level);
+  nlohmann::json out = {{"degree", args.degree}, {"level", args.level}, {"points", nlohmann::json::array()},
+                        {"parameters", nlohmann::json::array()}};
+  uint64_t i = 0;
+  for (const auto& line : lines)
+    for (const Vec3d& p : line) {
+      out["points"].push_back(point_json(p));
+      out["parameters"].push_back(cifs::nurbs_vertex_parameter(args.degree, knots, args.level, i++));
+    }
+  if (args.json) {
+    std::cout << out.dump() << "\n";
+  } else {
+    char line[160];
+    for (size_t k = 0; k < out["points"].size(); ++k) {
+      std::snprintf(line, sizeof line, "%.17g %.17g %.17g %.17g\n", out["parameters"][k].get<double>(),
+                    out["points"][k][0].get<double>(), out["points"][k][1].get<double>(), out["points"][k][2].get<double>());
+      std::cout << line;
+    }
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+std::function<int()> add_cifs_commands(CLI::App& app) {
+  auto cifs_args = std::make_shared<CifsArgs>();
+  auto nurbs_args = std::make_shared<NurbsArgs>();
+  CLI::App* cifs = app.add_subcommand("cifs", "Inspect controlled iterated function systems (CIFS)");
+  cifs->require_subcommand(1);
+  CLI::App* info = cifs->add_subcommand("info", "States, transitions, stationary states and fixed points of a system");
+  info->add_option("SYSTEM", cifs_args->system, "A system file (JSON) or a shipped system's name")->required();
+  info->add_flag("--json", cifs_args->json, "Print JSON");
+  CLI::App* tess = cifs->add_subcommand("tessellate", "The vertices of a system's tessellation at a level");
+  tess->add_option("SYSTEM", cifs_args->system, "A system file (JSON) or a shipped system's name")->required();
+  tess->add_option("--level", cifs_args->level, "Subdivision level (number of maps applied)")->check(CLI::Range(0, 24));
+  tess->add_option("--format", cifs_args->format, "json (points and pieces), csv (x,y,z) or obj");
+
+  CLI::App* nurbs = app.add_subcommand("nurbs", "NURBS curves as CIFS automata");
+  nurbs->require_subcommand(1);
+  CLI::App* automaton = nurbs->add_subcommand("automaton", "The automaton of one B-spline piece: states (inter-node windows) and matrices");
+  CLI::App* ntess = nurbs->add_subcommand("tessellate", "The points of one NURBS piece at a level (2^level + 1 points)");
+  for (CLI::App* sub : {automaton, ntess}) {
+    sub->add_option("--degree", nurbs_args->degree, "Degree d >= 1")->required()->check(CLI::Range(1, 12));
+    sub->add_option("--knots", nurbs_args->knots, "The 2d knots t0,t1,...,t(2d-1) of the piece")->required();
+    sub->add_flag("--json", nurbs_args->json, "Print JSON");
+  }
+  ntess->add_option("--control-points", nurbs_args->control_points,
+                    "JSON file: a list of d + 1 points [x, y, z] (mm), or [x, y, z, w] for a rational curve")
+      ->required();
+  ntess->add_option("--level", nurbs_args->level, "Subdivision level")->check(CLI::Range(0, 24));
+
+  return [=]() -> int {
+    if (*info) return cifs_info(*cifs_args);
+    if (*tess) return cifs_tessellate(*cifs_args);
+    if (*automaton) return nurbs_automaton_command(*nurbs_args);
+    if (*ntess) return nurbs_tessellate_command(*nurbs_args);
+    return -1;
+  };
+}
+
+}  // namespace lacuna

@@ -1,0 +1,141 @@
+// CIFS attractors turned into solids: Menger sponge, Sierpinski tetrahedron, NURBS shells, tube
+// frames, against closed forms and counts.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+
+#include "cifs/library.h"
+#include "cifs/solid_input.h"
+#include "cifs/tessellate.h"
+#include "errors.h"
+#include "solids/check.h"
+#include "solids/extract.h"
+#include "solids/rasterize.h"
+#include "solids/voxelize.h"
+
+namespace lacuna {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+MeshCheckReport solid(const cifs::Cifs& c, int level, const cifs::SolidOptions& options, double voxel) {
+  return check_mesh(extract_surface(voxelize(cifs::attractor_geometry(c, level, options), VolumeOptions{voxel, 3.0})));
+}
+
+// Faces half a voxel off the grid, so no plane passes through grid points.
+cifs::Cifs placed(const std::string& name, double scale, double shift) {
+  nlohmann::json spec = {{"library", name}, {"scale", scale}, {"translate_mm", {shift, shift, shift}}};
+  return cifs::parse_system(spec, "test", "system");
+}
+
+TEST(CifsSolids, MengerSpongeGenusAndVolume) {
+  const double side = 27, h = 1.0 / 3.0;
+  const int genus[] = {0, 5, 81, 1409};
+  for (int level = 1; level <= 3; ++level) {
+    MeshCheckReport r = solid(placed("menger_sponge", side, h / 2), level, {}, h);
+    EXPECT_TRUE(r.valid()) << level << ::testing::PrintToString(r.problems());
+    EXPECT_EQ(r.components, 1u);
+    EXPECT_EQ(r.genus, genus[level]) << "level " << level;
+    const double exact = side * side * side * std::pow(20.0 / 27.0, level);
+    EXPECT_NEAR(r.volume_mm3, exact, 0.005 * exact) << "level " << level;
+  }
+}
+
+TEST(CifsSolids, SierpinskiTetrahedronHalvesItsVolumePerLevel) {
+  const double edge = 30;
+  const double v0 = edge * edge * edge / (6 * std::sqrt(2.0));
+  for (int level = 0; level <= 3; ++level) {
+    // 50 voxels along every piece's edge: marching tetrahedra cut the sharp edges by a fraction
+    // of a voxel, which stays within 1 % at that resolution.
+    const double h = edge / std::pow(2.0, level) / 50;
+    MeshCheckReport r = solid(placed("sierpinski_tetrahedron", edge, h / 2), level, {}, h);
+    EXPECT_TRUE(r.valid()) << ::testing::PrintToString(r.problems());
+    const double exact = v0 / std::pow(2.0, level);
+    EXPECT_NEAR(r.volume_mm3, exact, 0.01 * exact) << "level " << level;
+  }
+}
+
+TEST(CifsSolids, StreamedBatchesGiveTheSameSolid) {
+  cifs::Cifs c = placed("menger_sponge", 9, 0.05);
+  cifs::SolidOptions whole, pieces;
+  pieces.batch_pieces = 37;  // 400 cubes in 11 batches
+  TriMesh a = extract_surface(voxelize(cifs::attractor_geometry(c, 2, whole), VolumeOptions{0.1, 3.0}));
+  TriMesh b = extract_surface(voxelize(cifs::attractor_geometry(c, 2, pieces), VolumeOptions{0.1, 3.0}));
+  EXPECT_TRUE(a.positions_mm == b.positions_mm);
+  EXPECT_TRUE(a.triangles == b.triangles);
+}
+
+TEST(CifsSolids, MirroredCellsAreStillSolid) {
+  // A cube whose corner order is mirrored (faces listed clockwise) rasterizes the same.
+  ConvexCells cells;
+  cells.corners_per_cell = 8;
+  cells.faces = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+  const double s = 4.05;
+  cells.corners_mm = {{0.05, 0.05, 0.05}, {0.05, s, 0.05}, {s, s, 0.05}, {s, 0.05, 0.05},
+                      {0.05, 0.05, s},    {0.05, s, s},    {s, s, s},    {s, 0.05, s}};
+  GeometrySet set;
+  set.cells.push_back(cells);
+  MeshCheckReport r = check_mesh(extract_surface(voxelize(set, VolumeOptions{0.1, 3.0})));
+  EXPECT_TRUE(r.valid());
+  EXPECT_NEAR(r.volume_mm3, 64.0, 1e-3 * 64);  // the edges lose a chamfer of a fraction of a voxel
+}
+
+TEST(CifsSolids, ThickenedNurbsShellVolume) {
+  // A gently curved bi-quadratic patch thickened to t: t times its area plus the half-cylinders
+  // along its border, pi t^2 / 8 per unit of perimeter; both measured on a fine tessellation.
+  nlohmann::json spec = {{"nurbs_surface", {{"u", {{"degree", 2}, {"knots", {0, 1, 2, 3}}}},
+                                            {"v", {{"degree", 2}, {"knots", {0, 1, 2.5, 3}}}}}},
+                         {"control_points_mm",
+                          {{{0.03, 0.03, 0}, {0.03, 12, 1.5}, {0.03, 24, 0}},
+                           {{12, 0.03, 1.5}, {12, 12, 3}, {12, 24, 1.5}},
+                           {{24, 0.03, 0}, {24, 12, 1.5}, {24, 24, 0}}}}};
+  cifs::Cifs c = cifs::parse_system(spec, "test", "system");
+  const double t = 1.0;
+  TriMesh fine = cifs::tessellate_surface(c, 8);
+  const double area = surface_area(fine);
+  // Perimeter: the border edges of the welded tessellation (used by one triangle only).
+  std::map<std::pair<uint32_t, uint32_t>, int> uses;
+  for (const auto& tri : fine.triangles)
+    for (int k = 0; k < 3; ++k) ++uses[{std::min(tri[k], tri[(k + 1) % 3]), std::max(tri[k], tri[(k + 1) % 3])}];
+  double perimeter = 0;
+  for (const auto& [edge, n] : uses)
+    if (n == 1) perimeter += norm(fine.positions_mm[edge.first] - fine.positions_mm[edge.second]);
+  cifs::SolidOptions options;
+  options.thickness_mm = t;
+  MeshCheckReport r = solid(c, 5, options, 0.1);
+  EXPECT_TRUE(r.valid()) << ::testing::PrintToString(r.problems());
+  EXPECT_EQ(r.genus, 0);
+  const double expected = area * t + kPi * t * t / 8 * perimeter;
+  EXPECT_NEAR(r.volume_mm3, expected, 0.01 * expected);
+}
+
+TEST(CifsSolids, KochCurveAsTubes) {
+  // A tube of radius r along the level-2 Koch curve (16 segments of 1/9 of 60 mm): genus 0, and
+  // the volume of a capsule chain with small turning angles is close to pi r^2 L + 4/3 pi r^3.
+  nlohmann::json spec = {{"library", "koch_curve"}, {"scale", 60}, {"translate_mm", {0.05, 0.05, 0.05}}};
+  cifs::Cifs c = cifs::parse_system(spec, "test", "system");
+  cifs::SolidOptions options;
+  options.radius_mm = 0.8;
+  MeshCheckReport r = solid(c, 2, options, 0.1);
+  EXPECT_TRUE(r.valid());
+  EXPECT_EQ(r.genus, 0);
+  EXPECT_EQ(r.components, 1u);
+  const double length = 60 * std::pow(4.0 / 3.0, 2);
+  const double tube = kPi * 0.64 * length + 4.0 / 3.0 * kPi * 0.512;
+  // Corners of 60 and 120 degrees overlap or add wedges of order r^3: within 2 %.
+  EXPECT_NEAR(r.volume_mm3, tube, 0.02 * tube);
+}
+
+TEST(CifsSolids, OptionsMustFitThePrimitives) {
+  cifs::SolidOptions tubes;
+  tubes.as = cifs::SolidOptions::As::kTubes;
+  tubes.radius_mm = 1;
+  EXPECT_THROW(cifs::attractor_geometry(cifs::library_system("menger_sponge"), 2, tubes), InvalidInput);
+  cifs::SolidOptions shell;  // no thickness
+  EXPECT_THROW(cifs::attractor_geometry(cifs::library_system("koch_curve"), 2, shell), InvalidInput);
+  EXPECT_THROW(cifs::attractor_geometry(cifs::library_system("menger_sponge"), 8, {}), ResourceLimit);
+}
+
+}  // namespace
+}  // namespace lacuna
