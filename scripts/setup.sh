@@ -4,7 +4,7 @@
 #
 #   scripts/setup.sh                      install and build
 #   scripts/setup.sh --run RECIPE [ARGS]  ... then `lacuna run RECIPE ARGS`
-#   scripts/setup.sh --test               ... with the test clients (PrusaSlicer, admesh), warnings
+#   scripts/setup.sh --test               ... with the test clients (PrusaSlicer, admesh, Gmsh, CalculiX), warnings
 #                                         as errors, then the whole test suite through CTest
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -25,7 +25,7 @@ packages=(build-essential cmake ninja-build ccache pkg-config
           nlohmann-json3-dev libcli11-dev libgtest-dev)
 if [ "$mode" = test ]; then
   # Real downstream clients the tests run the outputs through.
-  packages+=(prusa-slicer admesh)
+  packages+=(prusa-slicer admesh gmsh calculix-ccx)
 fi
 
 missing=()

@@ -140,6 +140,14 @@ struct GeometrySet {
   std::vector<GeometryStream> streams;  // batches of any of the above (streams inside ignored)
 };
 
+// A tetrahedral mesh for finite elements: every tetrahedron positively oriented (corner 3 on the
+// side the right-hand normal of corners 0, 1, 2 points to).
+struct TetMesh {
+  std::vector<Vec3d> nodes_mm;
+  std::vector<std::array<uint32_t, 4>> tets;
+  std::vector<int> regions;  // material region of each tetrahedron; empty when there is one
+};
+
 // Mesh statistics that depend only on the triangle list.
 Box3 bounding_box(const TriMesh& mesh);
 double signed_volume(const TriMesh& mesh);   // mm^3, divergence theorem, exact for closed meshes

@@ -110,6 +110,18 @@ TEST_P(Sample, RunsAndEveryOutputPassesTheChecks) {
     const std::string file = o["file"].get<std::string>();
     ASSERT_TRUE(fs::exists(file)) << file;
     EXPECT_TRUE(o["checks"]["valid"].get<bool>()) << file;
+    if (o.contains("tets")) {
+      // Tetrahedra: verified before writing (positive, volume of the surface); Gmsh reads them.
+      EXPECT_GT(o["tets"].get<uint64_t>(), 0u);
+      EXPECT_NEAR(o["volume_mm3"].get<double>(), o["surface_volume_mm3"].get<double>(),
+                  1e-5 * o["surface_volume_mm3"].get<double>());
+      if (o["format"] == "msh" && have("gmsh")) {
+        Result g = run("gmsh -0 " + quote(file) + " -o " + quote((dir / "g.msh").string()) + " -format msh22 -save_all",
+                       dir.path());
+        EXPECT_EQ(g.code, 0) << g.out << g.err;
+      }
+      continue;
+    }
     // The independent re-read through the `check` command.
     Result c = lacuna("check --json " + quote(file), dir.path());
     EXPECT_EQ(c.code, 0) << file << "\n" << c.out << c.err;
@@ -411,6 +423,10 @@ std::vector<BadCase> bad_cases() {
       {"cifs_knot_count", with_input(R"({"type": "cifs", "system": {"nurbs_curve": {"degree": 3, "knots": [0, 1, 2]}, "control_points_mm": [[0,0,0],[1,0,0],[2,0,0],[3,0,0]]}, "radius_mm": 1})"), "", "", "needs 6 knots"},
       {"cifs_point_count", with_input(R"({"type": "cifs", "system": {"nurbs_curve": {"degree": 2, "knots": [0, 1, 2, 3]}, "control_points_mm": [[0,0,0],[1,0,0]]}, "radius_mm": 1})"), "", "", "expected 3 control points"},
       {"cifs_matrix_not_barycentric", with_input(R"({"type": "cifs", "system": {"states": [{"name": "s", "control_points": 2}], "transitions": [{"from": "s", "symbol": 0, "to": "s", "matrix": [[1, 0.5], [0, 0.4]]}], "control_points_mm": [[0,0,0],[1,0,0]]}, "radius_mm": 1})"), "", "", "expected 1 (barycentric)"},
+      {"fea_settings_on_stl", R"({"inputs": {"x": )" + ok_input + R"(}, "outputs": [{"of": "x", "file": "x.stl", "fea": {"quality": 1.4}}]})", "", "", "tetrahedral settings need"},
+      {"fea_bad_quality", R"({"inputs": {"x": )" + ok_input + R"(}, "outputs": [{"of": "x", "file": "x.inp", "fea": {"quality": 0.5}}]})", "", "", "outputs[0].fea.quality"},
+      {"fea_bad_element", R"({"inputs": {"x": )" + ok_input + R"(}, "outputs": [{"of": "x", "file": "x.inp", "fea": {"element": "C3D8"}}]})", "", "", "C3D10"},
+      {"fea_unknown_region", R"({"inputs": {"x": )" + ok_input + R"(}, "outputs": [{"of": "x", "file": "x.msh", "fea": {"regions": ["y"]}}]})", "", "", "regions"},
       {"empty_result", R"({"inputs": {"a": {"type": "sphere", "radius_mm": 1}, "b": {"type": "sphere", "center_mm": [9, 0, 0], "radius_mm": 1}}, "operations": [{"name": "i", "op": "intersection", "of": ["a", "b"]}], "outputs": [{"of": "i", "file": "x.stl"}]})", "", "", "empty"},
   };
 }
@@ -438,6 +454,43 @@ TEST(Cli, MalformedInputIsRejectedWithExitTwoAndNothingWritten) {
   Result folder = lacuna("run " + quote(dir.path().string()), dir.path());
   EXPECT_EQ(folder.code, 2);
   EXPECT_NE(folder.err.find("folder"), std::string::npos);
+}
+
+// --- fea -----------------------------------------------------------------------------------------
+
+TEST(Cli, FeaFromMeshAndRecipe) {
+  TempDir dir;
+  write_file(dir / "tet.stl", binary_stl(tetrahedron_triangles(), 4));
+  Result ok = lacuna("fea " + quote((dir / "tet.stl").string()) + " -o " + quote((dir / "tet.inp").string()) +
+                         " --max-tet-volume 5 --json",
+                     dir.path());
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  nlohmann::json j = nlohmann::json::parse(ok.out);
+  EXPECT_NEAR(j["volume_mm3"].get<double>(), 1000.0 / 6.0, 1e-5 * 1000.0 / 6.0);
+  EXPECT_LE(j["max_tet_volume_mm3"].get<double>(), 5.0);
+  EXPECT_GE(j["tets"].get<uint64_t>(), 34u);  // at least 166.7 / 5
+  std::string inp = read_file(dir / "tet.inp");
+  EXPECT_NE(inp.find("*NODE"), std::string::npos);
+  EXPECT_NE(inp.find("*ELEMENT, TYPE=C3D4"), std::string::npos);
+
+  // --format must match the file; an open surface is refused with 4 and nothing written.
+  EXPECT_EQ(lacuna("fea " + quote((dir / "tet.stl").string()) + " -o " + quote((dir / "x.inp").string()) + " --format msh",
+                   dir.path()).code,
+            2);
+  auto open = tetrahedron_triangles();
+  open.pop_back();
+  write_file(dir / "open.stl", binary_stl(open, 3));
+  Result bad = lacuna("fea " + quote((dir / "open.stl").string()) + " -o " + quote((dir / "open.inp").string()), dir.path());
+  EXPECT_EQ(bad.code, 4) << bad.err;
+  EXPECT_FALSE(fs::exists(dir / "open.inp"));
+
+  // A recipe's first output, as Medit, without report.json beside it.
+  write_file(dir / "small.json", kSmallRecipe);
+  Result recipe = lacuna("fea " + quote((dir / "small.json").string()) + " -o " + quote((dir / "small.mesh").string()) +
+                             " --quiet", dir.path());
+  ASSERT_EQ(recipe.code, 0) << recipe.err;
+  EXPECT_NE(read_file(dir / "small.mesh").find("Tetrahedra"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir / "report.json"));
 }
 
 // --- check -------------------------------------------------------------------------------------

@@ -5,12 +5,17 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <new>
 
 #include "cli/cifs_commands.h"
+#include "cli/fea_output.h"
 #include "cli/run_recipe.h"
+#include "export/fea.h"
+#include "export/output_files.h"
+#include "solids/decimate.h"
 #include "errors.h"
 #include "export/mesh_io.h"
 #include "export/report.h"
@@ -47,12 +52,19 @@ int command_run(const std::string& recipe, const RunOptions& options, const Comm
     const auto& r = result.report;
     std::printf("lacuna: ran %s in %.2f s, peak memory %s\n", recipe.c_str(), r["total_seconds"].get<double>(),
                 format_bytes(r["peak_memory_bytes"].get<uint64_t>()).c_str());
-    for (const auto& out : r["outputs"])
-      std::printf("  wrote %s  (%llu triangles, %.6g mm3, %llu component%s, genus %lld, checks passed)\n",
-                  out["file"].get<std::string>().c_str(), (unsigned long long)out["triangles"].get<uint64_t>(),
-                  out["volume_mm3"].get<double>(), (unsigned long long)out["components"].get<uint64_t>(),
-                  out["components"].get<uint64_t>() == 1 ? "" : "s", (long long)out["genus"].get<int64_t>());
-    std::printf("  wrote %s\n", result.written.back().c_str());
+    for (const auto& out : r["outputs"]) {
+      if (out.contains("tets"))
+        std::printf("  wrote %s  (%llu nodes, %llu tetrahedra, %.6g mm3, dihedral angles %.3g-%.3g deg)\n",
+                    out["file"].get<std::string>().c_str(), (unsigned long long)out["nodes"].get<uint64_t>(),
+                    (unsigned long long)out["tets"].get<uint64_t>(), out["volume_mm3"].get<double>(),
+                    out["min_dihedral_deg"].get<double>(), out["max_dihedral_deg"].get<double>());
+      else
+        std::printf("  wrote %s  (%llu triangles, %.6g mm3, %llu component%s, genus %lld, checks passed)\n",
+                    out["file"].get<std::string>().c_str(), (unsigned long long)out["triangles"].get<uint64_t>(),
+                    out["volume_mm3"].get<double>(), (unsigned long long)out["components"].get<uint64_t>(),
+                    out["components"].get<uint64_t>() == 1 ? "" : "s", (long long)out["genus"].get<int64_t>());
+    }
+    if (result.written.size() > r["outputs"].size()) std::printf("  wrote %s\n", result.written.back().c_str());
   }
   return kExitOk;
 }
@@ -68,6 +80,82 @@ int command_check(const std::string& path, const CommonFlags& flags) {
     std::cout << path << ":\n" << check_report_text(report);
   }
   return report.valid() ? kExitOk : kExitCheckFailed;
+}
+
+struct FeaArgs {
+  std::string input;
+  std::string output;
+  std::string format;
+  double max_tet_volume = 0;
+  double quality = 0;
+  double min_dihedral = 0;
+  double decimate = 0;
+  bool msh2 = false;
+  bool c3d10 = false;
+  bool free_surface = false;
+};
+
+// `lacuna fea`: a recipe's first output, or a mesh file, into a tetrahedral mesh.
+int command_fea(const FeaArgs& args, const RunOptions& base, const CommonFlags& flags) {
+  namespace fs = std::filesystem;
+  std::string path = args.output;
+  if (!args.format.empty()) {
+    const std::string wanted = "." + args.format;
+    if (fs::path(path).extension() != wanted) throw InvalidInput("-o " + path + ": expected a file ending in " + wanted);
+  }
+  fea_format_from_path(path);  // throws for unknown extensions
+  RecipeOutput out;
+  out.file = fs::path(path).filename().string();
+  out.format = fs::path(path).extension().string().substr(1);
+  out.decimate_mm = args.decimate;
+  out.fea.max_tet_volume_mm3 = args.max_tet_volume;
+  out.fea.quality = args.quality;
+  out.fea.min_dihedral_deg = args.min_dihedral;
+  out.fea.msh_version_2 = args.msh2;
+  out.fea.quadratic = args.c3d10;
+  out.fea.preserve_surface = !args.free_surface;
+  nlohmann::json report;
+  if (fs::path(args.input).extension() == ".json") {
+    RunOptions options = base;
+    options.output_dir = fs::path(path).parent_path().empty() ? "." : fs::path(path).parent_path().string();
+    options.replace_outputs = {out};
+    options.write_report = false;
+    RunResult result = run_recipe(args.input, options);
+    if (result.exit_code != kExitOk) {
+      for (const auto& problem : result.report["outputs"][0]["checks"]["problems"])
+        std::cerr << "lacuna: " << path << ": " << problem.get<std::string>() << "\n";
+      return result.exit_code;
+    }
+    report = result.report["outputs"][0];
+  } else {
+    TriMesh surface = read_mesh(args.input);
+    if (args.decimate > 0) {
+      DecimateOptions d;
+      d.max_deviation_mm = args.decimate;
+      surface = decimate(surface, d);
+    }
+    FeaResult fea = make_fea_mesh(surface, out.fea);
+    report = fea_report_json(fea);
+    report["file"] = path;
+    if (!fea.valid()) {
+      for (const std::string& problem : fea.problems) std::cerr << "lacuna: " << args.input << ": " << problem << "\n";
+      if (flags.json) std::cout << report.dump(2) << "\n";
+      return kExitCheckFailed;
+    }
+    OutputTransaction transaction;
+    FeaWriteOptions w;
+    w.msh_version_2 = args.msh2;
+    w.quadratic = args.c3d10;
+    write_fea(transaction.stage(path), fea_format_from_path(path), fea.mesh, w);
+    transaction.commit();
+  }
+  if (flags.json) std::cout << report.dump(2) << "\n";
+  else if (!flags.quiet)
+    std::printf("lacuna: wrote %s  (%llu nodes, %llu tetrahedra, %.6g mm3, dihedral angles %.3g-%.3g deg)\n", path.c_str(),
+                (unsigned long long)report["nodes"].get<uint64_t>(), (unsigned long long)report["tets"].get<uint64_t>(),
+                report["volume_mm3"].get<double>(), report["min_dihedral_deg"].get<double>(),
+                report["max_dihedral_deg"].get<double>());
+  return kExitOk;
 }
 
 }  // namespace
@@ -98,6 +186,26 @@ int run_app(int argc, char** argv) {
                "free of self-intersections and degenerate faces, positive volume. Exit 0 only if valid.");
   check->add_option("MESH", mesh_path, "Mesh file")->required();
   add_common(check, flags);
+  FeaArgs fea_args;
+  CLI::App* fea = app.add_subcommand(
+      "fea", "Tetrahedral mesh for finite elements (TetGen) of a recipe's first output or of a mesh file");
+  fea->add_option("INPUT", fea_args.input, "Recipe (.json) or closed mesh (.stl .obj .ply .3mf)")->required();
+  fea->add_option("-o,--output", fea_args.output, "Output file: .inp (Abaqus/CalculiX), .msh (Gmsh), .vtu, .mesh (Medit)")
+      ->required();
+  fea->add_option("--format", fea_args.format, "inp, msh, vtu or mesh (must match the output's extension)")
+      ->check(CLI::IsMember({"inp", "msh", "vtu", "mesh"}));
+  fea->add_option("--max-tet-volume", fea_args.max_tet_volume, "Largest tetrahedron in mm3 (default: unbounded)")
+      ->check(CLI::PositiveNumber);
+  fea->add_option("--quality", fea_args.quality, "Radius-edge ratio bound, > 1 (e.g. 1.4; default: none)");
+  fea->add_option("--min-dihedral", fea_args.min_dihedral, "Smallest dihedral angle to aim for, degrees (with --quality)");
+  fea->add_option("--decimate", fea_args.decimate, "Decimate the surface to this deviation in mm first (re-checked)")
+      ->check(CLI::PositiveNumber);
+  fea->add_flag("--msh2", fea_args.msh2, "Gmsh format 2.2 instead of 4.1");
+  fea->add_flag("--c3d10", fea_args.c3d10, "Quadratic C3D10 elements in .inp (mid-side nodes)");
+  fea->add_flag("--free-surface", fea_args.free_surface, "Let TetGen add points on the surface (no -Y)");
+  fea->add_option("--voxel-size", run_options.voxel_size_mm, "Voxel size in mm for a recipe, overriding its own")
+      ->check(CLI::PositiveNumber);
+  add_common(fea, flags);
   std::function<int()> cifs_command = add_cifs_commands(app);
 
   try {
@@ -117,6 +225,7 @@ int run_app(int argc, char** argv) {
       return command_run(recipe, run_options, flags);
     }
     if (*check) return command_check(mesh_path, flags);
+    if (*fea) return command_fea(fea_args, run_options, flags);
     return cifs_command();
   } catch (const Error& e) {
     std::cerr << "lacuna: error: " << e.what() << "\n";

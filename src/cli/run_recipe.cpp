@@ -1,6 +1,7 @@
 #include "cli/run_recipe.h"
 
 #include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -9,12 +10,15 @@
 #include <set>
 
 #include "errors.h"
+#include "cli/fea_output.h"
+#include "export/fea.h"
 #include "export/mesh_io.h"
 #include "export/output_files.h"
 #include "export/report.h"
 #include "recipe/recipe.h"
 #include "solids/budget.h"
 #include "solids/check.h"
+#include "solids/decimate.h"
 #include "solids/extract.h"
 #include "solids/voxelize.h"
 #include "util/system.h"
@@ -32,6 +36,28 @@ std::string fixed(double v, int digits) {
   char text[64];
   std::snprintf(text, sizeof text, "%.*g", digits, v);
   return text;
+}
+
+// Material region of every tetrahedron: the first region solid its centroid lies in, else the
+// nearest one (tetrahedra straddling an interface go to the side holding their centroid).
+void assign_regions(TetMesh& mesh, const std::vector<Volume>& regions) {
+  mesh.regions.assign(mesh.tets.size(), 0);
+  tbb::parallel_for(size_t(0), mesh.tets.size(), [&](size_t t) {
+    const auto& tet = mesh.tets[t];
+    Vec3d c = (mesh.nodes_mm[tet[0]] + mesh.nodes_mm[tet[1]] + mesh.nodes_mm[tet[2]] + mesh.nodes_mm[tet[3]]) * 0.25;
+    double best = HUGE_VAL;
+    for (size_t r = 0; r < regions.size(); ++r) {
+      double d = regions[r].distance_at(c);
+      if (d < 0) {
+        mesh.regions[t] = int(r);
+        return;
+      }
+      if (d < best) {
+        best = d;
+        mesh.regions[t] = int(r);
+      }
+    }
+  });
 }
 
 // Runs `step`, prefixing any InvalidInput it throws with `where` (file and JSON path).
@@ -112,6 +138,23 @@ Plan make_plan(const Recipe& recipe) {
   std::set<std::string> meshed;
   for (const RecipeOutput& out : recipe.outputs)
     if (meshed.insert(out.object).second) ++plan.uses[out.object];
+  // Material regions of tetrahedral outputs are read after their object is meshed.
+  for (const RecipeOutput& out : recipe.outputs)
+    for (const std::string& name : out.fea.regions) {
+      ++plan.uses[name];
+      stack.push_back(name);
+    }
+  while (!stack.empty()) {
+    std::string name = stack.back();
+    stack.pop_back();
+    if (!plan.needed.insert(name).second) continue;
+    auto op = plan.operations.find(name);
+    if (op != plan.operations.end())
+      for (const std::string& o : op->second->operands) {
+        ++plan.uses[o];
+        stack.push_back(o);
+      }
+  }
   return plan;
 }
 
@@ -200,6 +243,12 @@ RunResult run_recipe(const std::string& recipe_path, const RunOptions& options) 
   timer.start("read");
   Recipe recipe = load_recipe(recipe_path);
   if (options.voxel_size_mm > 0) recipe.voxel_size_mm = options.voxel_size_mm;
+  if (!options.replace_outputs.empty()) {
+    std::vector<RecipeOutput> outputs = options.replace_outputs;
+    for (RecipeOutput& out : outputs)
+      if (out.object.empty()) out.object = recipe.outputs.front().object;
+    recipe.outputs = outputs;
+  }
   const VolumeOptions vopt{recipe.voxel_size_mm, recipe.band_voxels};
   const uint64_t budget = options.max_memory_bytes ? options.max_memory_bytes : available_memory_bytes() / 2;
 
@@ -297,29 +346,68 @@ RunResult run_recipe(const std::string& recipe_path, const RunOptions& options) 
       volume = Volume();
       if (mesh.triangles.empty())
         throw InvalidInput(recipe.file + ": \"" + object + "\" is empty: nothing is left to export");
+      // Decimated versions, one per deviation asked for, checked like the rest on what is written.
+      std::map<double, TriMesh> decimated;
+      auto surface_for = [&](double deviation) -> const TriMesh& {
+        if (deviation <= 0) return mesh;
+        auto it = decimated.find(deviation);
+        if (it == decimated.end()) {
+          timer.start("decimate");
+          DecimateOptions d;
+          d.max_deviation_mm = deviation;
+          it = decimated.emplace(deviation, decimate(mesh, d)).first;
+        }
+        return it->second;
+      };
       struct Written {
         const RecipeOutput* out;
         std::string temp;
         std::string final_path;
       };
       std::vector<Written> written;
-      timer.start("write");
       for (const RecipeOutput& out : recipe.outputs) {
         if (out.object != object) continue;
         std::string final_path = (out_dir / out.file).string();
-        std::string temp = transaction.stage(final_path);
-        if (out.format == "stl") {
-          write_stl(temp, mesh, "Lacuna " LACUNA_VERSION " " + recipe.name + " " + out.part_name);
-        } else {
-          ThreeMfInfo info;
-          info.object_name = out.part_name;
-          info.metadata = {{"Application", "Lacuna " LACUNA_VERSION}, {"Title", recipe.name}};
-          if (!recipe.description.empty()) info.metadata.push_back({"Description", recipe.description});
-          write_3mf(temp, mesh, info);
+        const TriMesh& surface = surface_for(out.decimate_mm);
+        if (out.format == "stl" || out.format == "3mf") {
+          timer.start("write");
+          std::string temp = transaction.stage(final_path);
+          if (out.format == "stl") {
+            write_stl(temp, surface, "Lacuna " LACUNA_VERSION " " + recipe.name + " " + out.part_name);
+          } else {
+            ThreeMfInfo info;
+            info.object_name = out.part_name;
+            info.metadata = {{"Application", "Lacuna " LACUNA_VERSION}, {"Title", recipe.name}};
+            if (!recipe.description.empty()) info.metadata.push_back({"Description", recipe.description});
+            write_3mf(temp, surface, info);
+          }
+          written.push_back({&out, temp, final_path});
+          continue;
         }
-        written.push_back({&out, temp, final_path});
+        timer.start("tetrahedralize");
+        FeaResult fea = make_fea_mesh(surface, out.fea);
+        if (fea.valid() && !out.fea.regions.empty()) {
+          std::vector<Volume> regions;
+          for (const std::string& name : out.fea.regions) regions.push_back(volumes.at(name));
+          assign_regions(fea.mesh, regions);
+        }
+        nlohmann::json entry = fea_report_json(fea);
+        if (fea.valid()) {
+          timer.start("write");
+          FeaWriteOptions w;
+          w.msh_version_2 = out.fea.msh_version_2;
+          w.quadratic = out.fea.quadratic;
+          write_fea(transaction.stage(final_path), fea_format_from_path(final_path), fea.mesh, w);
+        }
+        entry["file"] = final_path;
+        entry["format"] = out.format;
+        entry["object"] = out.object;
+        entry["voxels"] = voxels;
+        outputs.push_back(entry);
+        all_valid = all_valid && fea.valid();
       }
       mesh = TriMesh();
+      decimated.clear();
       timer.start("check");
       for (const Written& w : written) {
         ReadOptions read;
@@ -332,9 +420,14 @@ RunResult run_recipe(const std::string& recipe_path, const RunOptions& options) 
         entry["object"] = w.out->object;
         entry["part_name"] = w.out->part_name;
         entry["voxels"] = voxels;
+        if (w.out->decimate_mm > 0) entry["decimated_mm"] = w.out->decimate_mm;
         outputs.push_back(entry);
         all_valid = all_valid && report.valid();
       }
+      for (const RecipeOutput& out : recipe.outputs)
+        if (out.object == object)
+          for (const std::string& name : out.fea.regions)
+            if (--uses[name] == 0) volumes.erase(name);
     }
     timer.stop();
 
@@ -356,6 +449,7 @@ RunResult run_recipe(const std::string& recipe_path, const RunOptions& options) 
         {"stage_seconds", stages},
         {"total_seconds", total},
         {"peak_memory_bytes", peak_memory_bytes()},
+        {"peak_memory_children_bytes", peak_child_memory_bytes()},
         {"memory_estimate_bytes", need_bytes},
         {"memory_budget_bytes", budget},
         {"threads", tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)},
@@ -367,11 +461,10 @@ RunResult run_recipe(const std::string& recipe_path, const RunOptions& options) 
       return result;
     }
     std::string report_path = (out_dir / "report.json").string();
-    std::string report_temp = transaction.stage(report_path);
-    write_text_file_atomically(report_temp, result.report.dump(2) + "\n");
+    if (options.write_report) write_text_file_atomically(transaction.stage(report_path), result.report.dump(2) + "\n");
     transaction.commit();
     for (const auto& o : outputs) result.written.push_back(o["file"].get<std::string>());
-    result.written.push_back(report_path);
+    if (options.write_report) result.written.push_back(report_path);
     return result;
   } catch (...) {
     transaction.rollback();

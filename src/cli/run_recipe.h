@@ -7,12 +7,18 @@
 #include <string>
 #include <vector>
 
+#include "recipe/recipe.h"
+
 namespace lacuna {
 
 struct RunOptions {
   std::string output_dir;         // empty: "<recipe name>-out" in the working folder
   double voxel_size_mm = 0;       // > 0 overrides the recipe's voxel size
   uint64_t max_memory_bytes = 0;  // 0: half the memory available to the process
+  // When not empty, these outputs replace the recipe's (an empty `object` names the recipe's
+  // first output's object); used by `lacuna fea`.
+  std::vector<RecipeOutput> replace_outputs;
+  bool write_report = true;       // report.json next to the outputs
 };
 
 struct RunResult {

@@ -310,7 +310,7 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
   std::set<std::string> files;
   for (size_t i = 0; i < outs.size(); ++i) {
     JsonObject o(outs[i], path, "outputs[" + std::to_string(i) + "]");
-    o.allow_only({"of", "file", "name"});
+    o.allow_only({"of", "file", "name", "decimate_mm", "fea"});
     RecipeOutput out;
     out.json_path = o.path();
     out.object = o.string("of");
@@ -324,11 +324,45 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
         out.file == "." || out.file == ".." || out.file[0] == '.')
       o.fail("file", "expected a plain file name such as \"part.stl\" (outputs go to the output folder)");
     std::string ext = lower(fs::path(out.file).extension().string());
-    if (ext == ".stl") out.format = "stl";
-    else if (ext == ".3mf") out.format = "3mf";
-    else o.fail("file", "expected a file name ending in .stl or .3mf, got \"" + out.file + "\"");
+    const std::map<std::string, std::string> formats = {{".stl", "stl"}, {".3mf", "3mf"}, {".msh", "msh"},
+                                                        {".inp", "inp"}, {".vtu", "vtu"}, {".mesh", "mesh"}};
+    auto format = formats.find(ext);
+    if (format == formats.end())
+      o.fail("file", "expected a file name ending in .stl or .3mf (or .msh, .inp, .vtu, .mesh for tetrahedra), got \"" +
+                         out.file + "\"");
+    out.format = format->second;
     if (lower(out.file) == "report.json" || !files.insert(lower(out.file)).second)
       o.fail("file", "\"" + out.file + "\" is written twice or clashes with report.json");
+    out.decimate_mm = o.positive_length_or("decimate_mm", 0.0);
+    const bool tetrahedral = out.format != "stl" && out.format != "3mf";
+    if (o.has("fea")) {
+      if (!tetrahedral) o.fail("fea", "tetrahedral settings need a .msh, .inp, .vtu or .mesh file");
+      JsonObject f = o.object("fea");
+      f.allow_only({"max_tet_volume_mm3", "quality", "min_dihedral_deg", "preserve_surface", "msh_version", "element",
+                    "regions", "time_limit_s"});
+      out.fea.max_tet_volume_mm3 = f.positive_length_or("max_tet_volume_mm3", 0.0);
+      out.fea.quality = f.number_or("quality", 0.0);
+      if (out.fea.quality != 0 && !(out.fea.quality > 1.0)) f.fail("quality", "expected a radius-edge ratio above 1 (e.g. 1.4)");
+      out.fea.min_dihedral_deg = f.number_or("min_dihedral_deg", 0.0);
+      if (out.fea.min_dihedral_deg < 0 || out.fea.min_dihedral_deg >= 70) f.fail("min_dihedral_deg", "expected 0 to 70 degrees");
+      out.fea.preserve_surface = f.boolean_or("preserve_surface", true);
+      std::string version = f.string_or("msh_version", "4.1");
+      if (version != "4.1" && version != "2.2") f.fail("msh_version", "expected \"4.1\" or \"2.2\"");
+      out.fea.msh_version_2 = version == "2.2";
+      std::string element = f.string_or("element", "C3D4");
+      if (element != "C3D4" && element != "C3D10") f.fail("element", "expected \"C3D4\" or \"C3D10\"");
+      out.fea.quadratic = element == "C3D10";
+      out.fea.time_limit_s = f.positive_length_or("time_limit_s", 600);
+      if (f.has("regions")) {
+        const nlohmann::json& regions = f.required("regions");
+        if (!regions.is_array()) f.fail("regions", "expected a list of input or operation names");
+        for (const auto& r : regions) {
+          if (!r.is_string() || !names.count(r.get<std::string>()))
+            f.fail("regions", "expected names of inputs or operations, got " + r.dump());
+          out.fea.regions.push_back(r.get<std::string>());
+        }
+      }
+    }
     out.part_name = o.string_or("name", out.object);
     recipe.outputs.push_back(std::move(out));
   }

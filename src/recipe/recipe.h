@@ -37,11 +37,25 @@ struct RecipeOperation {
   double thickness_mm = 0;            // shell: wall thickness inward
 };
 
+// Settings of a tetrahedral (FEA) output.
+struct FeaSettings {
+  double max_tet_volume_mm3 = 0;      // 0: unbounded
+  double quality = 0;                 // radius-edge ratio bound (> 1); 0: none
+  double min_dihedral_deg = 0;        // with a quality bound; 0: TetGen's default
+  bool preserve_surface = true;       // tetrahedra meet the surface's triangles exactly
+  bool msh_version_2 = false;         // Gmsh 2.2 instead of 4.1
+  bool quadratic = false;             // .inp with C3D10 elements
+  std::vector<std::string> regions;   // objects whose insides are material regions 0, 1, ...
+  double time_limit_s = 600;
+};
+
 struct RecipeOutput {
   std::string object;     // the input or operation to export
   std::string file;       // a plain file name inside the output folder
-  std::string format;     // "stl" or "3mf", from the extension
+  std::string format;     // "stl", "3mf", or a tetrahedral format "msh", "inp", "vtu", "mesh"
   std::string part_name;  // object name inside the file (3MF)
+  double decimate_mm = 0; // > 0: decimate the surface to this deviation first (re-checked)
+  FeaSettings fea;        // for tetrahedral formats
   std::string json_path;
 };
 

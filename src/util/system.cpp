@@ -1,5 +1,6 @@
 #include "util/system.h"
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -43,6 +44,12 @@ uint64_t status_field_bytes(const char* field) {
 uint64_t peak_memory_bytes() { return status_field_bytes("VmHWM"); }
 
 uint64_t current_memory_bytes() { return status_field_bytes("VmRSS"); }
+
+uint64_t peak_child_memory_bytes() {
+  rusage usage{};
+  if (getrusage(RUSAGE_CHILDREN, &usage) != 0) return 0;
+  return uint64_t(usage.ru_maxrss) * 1024;  // kilobytes on Linux
+}
 
 void StageTimer::start(const std::string& stage) {
   stop();

@@ -16,6 +16,10 @@ uint64_t available_memory_bytes();
 // Peak resident set size of this process so far, in bytes (VmHWM); 0 where unknown.
 uint64_t peak_memory_bytes();
 
+// Peak resident set size of the largest child process this process has waited for (TetGen runs
+// in one), in bytes; 0 where unknown.
+uint64_t peak_child_memory_bytes();
+
 // Resident set size of this process now, in bytes (VmRSS); 0 where unknown.
 uint64_t current_memory_bytes();
 

@@ -1,0 +1,60 @@
+#include "cli/fea_output.h"
+
+#include <cmath>
+
+#include "export/report.h"
+
+namespace lacuna {
+
+FeaResult make_fea_mesh(const TriMesh& surface, const FeaSettings& settings, const std::vector<Vec3d>& region_seeds) {
+  FeaResult r;
+  r.surface = check_mesh(surface);
+  if (!r.surface.valid()) {
+    for (const std::string& p : r.surface.problems()) r.problems.push_back("surface: " + p);
+    return r;
+  }
+  TetOptions options;
+  options.max_radius_edge_ratio = settings.quality;
+  options.min_dihedral_deg = settings.min_dihedral_deg;
+  options.max_tet_volume_mm3 = settings.max_tet_volume_mm3;
+  options.preserve_surface = settings.preserve_surface;
+  options.time_limit_s = settings.time_limit_s;
+  r.mesh = tetrahedralize(surface, options, region_seeds);
+  r.report = tet_report(r.mesh);
+  if (r.report.tets == 0) r.problems.push_back("TetGen produced no tetrahedra");
+  if (r.report.inverted_tets) r.problems.push_back(std::to_string(r.report.inverted_tets) + " tetrahedra have no positive volume");
+  // A preserved surface bounds exactly the same volume; when TetGen may refine, it can also
+  // re-triangulate facets it takes as coplanar (its -T tolerance), which moves the volume by a few
+  // parts per million.
+  const double expected = r.surface.volume_mm3;
+  const bool preserved = options.preserve_surface && options.max_radius_edge_ratio == 0 && options.max_tet_volume_mm3 == 0;
+  const double tolerance = preserved ? 1e-6 : 1e-5;
+  if (std::fabs(r.report.volume_mm3 - expected) > tolerance * expected)
+    r.problems.push_back("the tetrahedra's volume " + std::to_string(r.report.volume_mm3) +
+                         " mm3 differs from the surface's " + std::to_string(expected) + " mm3");
+  if (settings.max_tet_volume_mm3 > 0 && r.report.max_tet_volume_mm3 > settings.max_tet_volume_mm3 * (1 + 1e-9))
+    r.problems.push_back("a tetrahedron exceeds the volume bound");
+  return r;
+}
+
+nlohmann::json fea_report_json(const FeaResult& r) {
+  nlohmann::json histogram = nlohmann::json::array();
+  for (size_t i = 0; i < r.report.ratio_counts.size(); ++i)
+    histogram.push_back({{"below", i < r.report.ratio_bins.size() ? nlohmann::json(r.report.ratio_bins[i]) : nlohmann::json(nullptr)},
+                         {"tets", r.report.ratio_counts[i]}});
+  return {{"nodes", r.report.nodes},
+          {"tets", r.report.tets},
+          {"volume_mm3", r.report.volume_mm3},
+          {"surface_volume_mm3", r.surface.volume_mm3},
+          {"surface_triangles", r.surface.triangles},
+          {"min_tet_volume_mm3", r.report.min_tet_volume_mm3},
+          {"max_tet_volume_mm3", r.report.max_tet_volume_mm3},
+          {"min_dihedral_deg", r.report.min_dihedral_deg},
+          {"max_dihedral_deg", r.report.max_dihedral_deg},
+          {"radius_edge_ratio_histogram", histogram},
+          {"components", r.surface.components},
+          {"genus", r.surface.genus},
+          {"checks", {{"valid", r.valid()}, {"problems", r.problems}}}};
+}
+
+}  // namespace lacuna
