@@ -13,6 +13,7 @@
 #include <numeric>
 #include <unordered_map>
 
+#include "solids/components.h"
 #include "util/progress.h"
 
 namespace lacuna {
@@ -185,6 +186,15 @@ bool self_intersects(const TriMesh& mesh, const Box3& box, bool& built, Progress
 }
 
 }  // namespace
+
+std::vector<uint32_t> component_depths(const TriMesh& mesh) {
+  std::vector<MeshComponent> components = mesh_components(mesh);
+  std::vector<uint32_t> component_of(mesh.positions_mm.size(), 0);
+  for (size_t c = 0; c < components.size(); ++c)
+    for (uint32_t f : components[c].triangles)
+      for (uint32_t v : mesh.triangles[f]) component_of[v] = uint32_t(c);
+  return nesting_depths(mesh, component_of, components.size());
+}
 
 bool MeshCheckReport::valid() const {
   return triangles > 0 && non_finite_vertices == 0 && bad_indices == 0 && degenerate_faces == 0 && closed() &&

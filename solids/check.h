@@ -49,4 +49,9 @@ struct MeshCheckReport {
 // Runs every check on the mesh. Deterministic; parallel where it pays.
 MeshCheckReport check_mesh(const TriMesh& mesh, const CheckOptions& options = {});
 
+// How many other components enclose each component of the mesh, in the order of
+// mesh_components() (solids/components.h): the parity of exact ray crossings. The components must
+// not intersect each other.
+std::vector<uint32_t> component_depths(const TriMesh& mesh);
+
 }  // namespace lacuna

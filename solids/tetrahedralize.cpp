@@ -13,10 +13,10 @@
 #include <cerrno>
 #include <cstring>
 #include <new>
-#include <numeric>
 #include <stdexcept>
 
 #include "errors.h"
+#include "solids/components.h"
 #include "util/progress.h"
 
 namespace lacuna {
@@ -130,41 +130,6 @@ bool write_all(int fd, const void* data, size_t size) {
   ::_exit(0);
 }
 
-// Components (through shared vertices), their signed volumes and one triangle each.
-struct Component {
-  double volume6 = 0;
-  uint32_t triangle = 0;
-};
-
-std::vector<Component> components(const TriMesh& m) {
-  std::vector<uint32_t> parent(m.positions_mm.size());
-  std::iota(parent.begin(), parent.end(), 0u);
-  auto find = [&](uint32_t v) {
-    while (parent[v] != v) v = parent[v] = parent[parent[v]];
-    return v;
-  };
-  for (const auto& t : m.triangles) {
-    uint32_t a = find(t[0]), b = find(t[1]), c = find(t[2]);
-    parent[std::max(a, b)] = std::min(a, b);
-    a = find(a);
-    c = find(c);
-    parent[std::max(a, c)] = std::min(a, c);
-  }
-  std::vector<int> index(m.positions_mm.size(), -1);
-  std::vector<Component> out;
-  for (uint32_t f = 0; f < m.triangles.size(); ++f) {
-    const auto& t = m.triangles[f];
-    uint32_t root = find(t[0]);
-    if (index[root] < 0) {
-      index[root] = int(out.size());
-      out.push_back(Component{0, f});
-    }
-    const Vec3d &a = m.positions_mm[t[0]], &b = m.positions_mm[t[1]], &c = m.positions_mm[t[2]];
-    out[size_t(index[root])].volume6 += dot(a, cross(b, c));
-  }
-  return out;
-}
-
 double tet_volume(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& d) {
   return dot(b - a, cross(c - a, d - a)) / 6.0;
 }
@@ -204,9 +169,9 @@ TetMesh tetrahedralize(const TriMesh& surface, const TetOptions& options, const 
     throw ResourceLimit("the surface is too large for TetGen's 32-bit indices");
   // Cavities (components oriented inward) stay empty: a hole point just inside each.
   std::vector<Vec3d> holes;
-  for (const Component& c : components(surface)) {
-    if (c.volume6 >= 0) continue;
-    const auto& t = surface.triangles[c.triangle];
+  for (const MeshComponent& c : mesh_components(surface)) {
+    if (c.signed_volume_mm3 >= 0) continue;
+    const auto& t = surface.triangles[c.triangles.front()];
     const Vec3d &a = surface.positions_mm[t[0]], &b = surface.positions_mm[t[1]], &d = surface.positions_mm[t[2]];
     Vec3d n = cross(b - a, d - a);
     double shortest = std::min({norm(b - a), norm(d - b), norm(a - d)});

@@ -11,6 +11,8 @@
 #include <openvdb/tools/ValueTransformer.h>
 
 #include "errors.h"
+#include "solids/check.h"
+#include "solids/components.h"
 #include "solids/extract.h"
 #include "solids/vdb_internal.h"
 #include "util/progress.h"
@@ -162,13 +164,53 @@ double Volume::voxel_volume_mm3() const {
   return static_cast<double>(voxels) * h * h * h;
 }
 
-Volume mesh_to_volume(const TriMesh& mesh, const VolumeOptions& options) {
-  if (mesh.triangles.empty()) throw InvalidInput("mesh has no triangles");
+namespace {
+
+Volume closed_mesh_volume(const TriMesh& mesh, const VolumeOptions& options) {
   auto grid = make_level_set_grid(options);  // validates the options
   double band = options.voxel_size_mm * options.half_band_voxels;
   grid = mesh_distance(mesh, options.voxel_size_mm, band, band, "mesh to volume");
   rebuild_band(*grid, 0.0f, static_cast<float>(band));
   return wrap_grid(grid, options);
+}
+
+}  // namespace
+
+Volume mesh_to_volume(const TriMesh& mesh, const VolumeOptions& options) {
+  if (mesh.triangles.empty()) throw InvalidInput("mesh has no triangles");
+  // meshToVolume fills whatever the outside cannot reach, cavities included. A mesh with
+  // inward-facing shells (cavities, and islands inside them) is built level by level of nesting:
+  // shells at even depth added, at odd depth taken away.
+  std::vector<MeshComponent> components = mesh_components(mesh);
+  bool cavities = false;
+  for (const MeshComponent& c : components) cavities = cavities || c.signed_volume_mm3 < 0;
+  if (!cavities) return closed_mesh_volume(mesh, options);
+  std::vector<uint32_t> depth = component_depths(mesh);
+  uint32_t deepest = *std::max_element(depth.begin(), depth.end());
+  Volume result;
+  for (uint32_t d = 0; d <= deepest; ++d) {
+    TriMesh level;
+    std::vector<int64_t> index(mesh.positions_mm.size(), -1);
+    for (size_t c = 0; c < components.size(); ++c) {
+      if (depth[c] != d) continue;
+      for (uint32_t f : components[c].triangles) {
+        std::array<uint32_t, 3> t{};
+        for (int k = 0; k < 3; ++k) {
+          uint32_t v = mesh.triangles[f][size_t(k)];
+          if (index[v] < 0) {
+            index[v] = int64_t(level.positions_mm.size());
+            level.positions_mm.push_back(mesh.positions_mm[v]);
+          }
+          t[size_t(k)] = uint32_t(index[v]);
+        }
+        level.triangles.push_back(t);
+      }
+    }
+    if (level.triangles.empty()) continue;
+    Volume v = closed_mesh_volume(level, options);
+    result = d % 2 == 0 ? unite(result, v) : subtract(result, v);
+  }
+  return result;
 }
 
 Volume unite(const Volume& a, const Volume& b) {

@@ -405,7 +405,7 @@ std::vector<BadCase> bad_cases() {
       {"torus_fat", with_input(R"({"type": "torus", "major_radius_mm": 2, "minor_radius_mm": 3})"), "", "", "minor_radius_mm"},
       {"mesh_file_missing", with_input(R"({"type": "mesh", "file": "nowhere.stl"})"), "", "", "does not exist"},
       {"mesh_truncated_stl", with_input(mesh_input), "hull.stl", truncated, "hull.stl"},
-      {"mesh_open", with_input(mesh_input), "hull.stl", binary_stl(open, 3), "not a closed mesh"},
+      {"mesh_open", with_input(mesh_input), "hull.stl", binary_stl(open, 3), "is not a valid closed solid"},
       {"mesh_nan", with_input(mesh_input), "hull.stl", binary_stl(nan, 4), "hull.stl"},
       {"mesh_obj_bad_index", with_input(R"({"type": "mesh", "file": "hull.obj"})"), "hull.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n", "hull.obj"},
       {"mesh_absurd_ply", with_input(R"({"type": "mesh", "file": "hull.ply"})"), "hull.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n", "hull.ply"},
@@ -454,6 +454,88 @@ TEST(Cli, MalformedInputIsRejectedWithExitTwoAndNothingWritten) {
   Result folder = lacuna("run " + quote(dir.path().string()), dir.path());
   EXPECT_EQ(folder.code, 2);
   EXPECT_NE(folder.err.find("folder"), std::string::npos);
+}
+
+// --- hulls, infill, printability -----------------------------------------------------------------
+
+std::vector<std::array<float, 9>> shifted(std::vector<std::array<float, 9>> tris, float dx) {
+  for (auto& t : tris)
+    for (int k = 0; k < 3; ++k) t[size_t(3 * k)] += dx;
+  return tris;
+}
+
+TEST(Cli, BrokenHullsAreRefusedUnlessRepairedExplicitly) {
+  TempDir dir;
+  auto tets = tetrahedron_triangles();
+  auto flipped = tets;
+  for (auto& t : flipped)
+    for (int a = 0; a < 3; ++a) std::swap(t[3 + a], t[6 + a]);
+  auto overlapping = tets;
+  for (const auto& t : shifted(tets, 4)) overlapping.push_back(t);
+  write_file(dir / "flipped.stl", binary_stl(flipped, 4));
+  write_file(dir / "overlapping.stl", binary_stl(overlapping, 8));
+  auto recipe = [&](const std::string& file, const std::string& repair) {
+    return R"({"voxel_size_mm": 0.25, "inputs": {"hull": {"type": "mesh", "file": ")" + file + "\"" + repair +
+           R"(}}, "outputs": [{"of": "hull", "file": "hull.stl"}]})";
+  };
+  struct Case {
+    const char* file;
+    const char* problem;
+    const char* repair;
+  };
+  for (const Case& c : {Case{"flipped.stl", "components are oriented inward", R"(, "repair": {"reorient": true})"},
+                        Case{"overlapping.stl", "the mesh intersects itself", R"(, "repair": {"allow_overlaps": true})"}}) {
+    write_file(dir / "broken.json", recipe(c.file, ""));
+    const fs::path out = dir / (std::string(c.file) + "-out");
+    Result r = lacuna("run " + quote((dir / "broken.json").string()) + " -o " + quote(out.string()), dir.path());
+    EXPECT_EQ(r.code, 2) << c.file;
+    EXPECT_NE(r.err.find("is not a valid closed solid"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(c.problem), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("\"repair\""), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+    write_file(dir / "repaired.json", recipe(c.file, c.repair));
+    Result fixed = lacuna("run " + quote((dir / "repaired.json").string()) + " -o " + quote(out.string()) +
+                              " --quiet --json", dir.path());
+    ASSERT_EQ(fixed.code, 0) << c.file << ": " << fixed.err;
+    double volume = nlohmann::json::parse(fixed.out)["outputs"][0]["volume_mm3"].get<double>();
+    // The tetrahedron (1000 / 6 mm3) or two of them overlapping by a corner (exact union of the two
+    // less the overlap, a tetrahedron of edge 6: 36 mm3).
+    double expected = std::string(c.file) == "flipped.stl" ? 1000.0 / 6 : 2000.0 / 6 - 36.0;
+    EXPECT_NEAR(volume, expected, 0.03 * expected) << c.file;
+  }
+}
+
+TEST(Cli, CheckPrintFindsTheTrappedVoid) {
+  TempDir dir;
+  // A 20 mm cube around a sealed 10 mm cubic cavity (the inner shell faces inward).
+  std::vector<std::array<float, 9>> tris;
+  auto cube = [&](float lo, float hi, bool inward) {
+    const int f[12][3] = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
+                          {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
+    for (const auto& t : f) {
+      std::array<float, 9> tri;
+      for (int k = 0; k < 3; ++k) {
+        int v = t[inward ? (3 - k) % 3 : k];
+        tri[size_t(3 * k)] = v & 1 ? hi : lo;
+        tri[size_t(3 * k + 1)] = v & 2 ? hi : lo;
+        tri[size_t(3 * k + 2)] = v & 4 ? hi : lo;
+      }
+      tris.push_back(tri);
+    }
+  };
+  cube(0, 20, false);
+  cube(5, 15, true);
+  write_file(dir / "void.stl", binary_stl(tris, 24));
+  Result r = lacuna("check --print --min-wall 1 --build-dir z --json " + quote((dir / "void.stl").string()), dir.path());
+  EXPECT_EQ(r.code, 4) << r.err;
+  nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_TRUE(j["checks"]["valid"].get<bool>());  // a valid solid, but not printable as it is
+  ASSERT_EQ(j["trapped_voids"].size(), 1u);
+  EXPECT_NEAR(j["trapped_voids"][0]["volume_mm3"].get<double>(), 1000, 0.01 * 1000);
+  EXPECT_NEAR(j["trapped_voids"][0]["location"][2].get<double>(), 10, 0.05);
+  EXPECT_TRUE(j["thin_walls"].empty());
+  // The cavity's ceiling (100 mm2) faces down: overhang.
+  EXPECT_NEAR(j["printability"]["overhang_area_mm2"].get<double>(), 100, 2);
 }
 
 // --- fea -----------------------------------------------------------------------------------------

@@ -247,6 +247,28 @@ TEST(Solids, ClosedMeshToVolume) {
   EXPECT_NEAR(r.volume_mm3, 4.0 / 3.0 * 64, 0.005 * 4.0 / 3.0 * 64);
 }
 
+TEST(Solids, ClosedMeshWithCavityAndIsland) {
+  // A cube of 12 around a cavity of 8 (facing inward) holding an island of 4: 1728 - 512 + 64.
+  TriMesh m;
+  auto cube = [&](double lo, double hi, bool inward) {
+    uint32_t base = uint32_t(m.positions_mm.size());
+    for (int i = 0; i < 8; ++i) m.positions_mm.push_back({i & 1 ? hi : lo, i & 2 ? hi : lo, i & 4 ? hi : lo});
+    const uint32_t f[12][3] = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
+                               {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
+    for (const auto& t : f) m.triangles.push_back({base + t[0], base + (inward ? t[2] : t[1]), base + (inward ? t[1] : t[2])});
+  };
+  cube(0.05, 12.05, false);
+  cube(2.05, 10.05, true);
+  cube(4.05, 8.05, false);
+  ASSERT_TRUE(check_mesh(m).valid());
+  GeometrySet set;
+  set.solids.push_back(m);
+  MeshCheckReport r = mesh_and_check(voxelize(set, VolumeOptions{0.1, 3.0}));
+  EXPECT_TRUE(r.valid());
+  EXPECT_EQ(r.components, 3u);
+  EXPECT_NEAR(r.volume_mm3, 1728 - 512 + 64, 0.005 * 1280);
+}
+
 TEST(Solids, ExtrudedRegionWithHole) {
   Region2 region;
   region.loops_mm = {{{0, 0}, {10, 0}, {10, 6}, {0, 6}}, {{2, 2}, {4, 2}, {4, 4}, {2, 4}}};

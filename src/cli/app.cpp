@@ -9,6 +9,7 @@
 #include <iostream>
 #include <memory>
 #include <new>
+#include <sstream>
 
 #include "cli/cifs_commands.h"
 #include "cli/fea_output.h"
@@ -16,6 +17,8 @@
 #include "export/fea.h"
 #include "export/output_files.h"
 #include "solids/decimate.h"
+#include "solids/printability.h"
+#include "solids/volume.h"
 #include "errors.h"
 #include "export/mesh_io.h"
 #include "export/report.h"
@@ -69,17 +72,85 @@ int command_run(const std::string& recipe, const RunOptions& options, const Comm
   return kExitOk;
 }
 
-int command_check(const std::string& path, const CommonFlags& flags) {
+struct PrintArgs {
+  bool enabled = false;
+  double min_wall = 0, min_hole = 0, critical_angle = 45, voxel = 0;
+  std::string build_dir = "z";
+};
+
+Vec3d parse_direction(const std::string& text) {
+  if (text == "x" || text == "+x") return {1, 0, 0};
+  if (text == "y" || text == "+y") return {0, 1, 0};
+  if (text == "z" || text == "+z") return {0, 0, 1};
+  if (text == "-x") return {-1, 0, 0};
+  if (text == "-y") return {0, -1, 0};
+  if (text == "-z") return {0, 0, -1};
+  double x, y, z;
+  char c1, c2;
+  std::istringstream in(text);
+  if (in >> x >> c1 >> y >> c2 >> z && c1 == ',' && c2 == ',' && (x != 0 || y != 0 || z != 0)) return {x, y, z};
+  throw InvalidInput("--build-dir: expected x, y, z, -x, -y, -z or \"dx,dy,dz\", got \"" + text + "\"");
+}
+
+int command_check(const std::string& path, const CommonFlags& flags, const PrintArgs& print) {
   TriMesh mesh = read_mesh(path);
   MeshCheckReport report = check_mesh(mesh);
+  nlohmann::json j = check_report_json(report);
+  j["file"] = path;
+  bool printable = true;
+  PrintabilityReport pr;
+  if (print.enabled) {
+    if (!report.closed()) throw InvalidInput(path + ": printability needs a closed mesh");
+    // Resolve the smallest size asked about by four voxels, else the part by 300.
+    double h = print.voxel;
+    if (!(h > 0)) {
+      double smallest = HUGE_VAL;
+      for (double v : {print.min_wall, print.min_hole})
+        if (v > 0) smallest = std::min(smallest, v / 4);
+      h = std::isfinite(smallest) ? smallest : norm(report.bounding_box.size()) / 300;
+    }
+    PrintabilityOptions options;
+    options.min_wall_mm = print.min_wall;
+    options.min_hole_mm = print.min_hole;
+    options.build_direction = parse_direction(print.build_dir);
+    options.critical_angle_deg = print.critical_angle;
+    pr = analyze_printability(mesh_to_volume(mesh, VolumeOptions{h, 3.0}), options);
+    j["printability"] = {{"voxel_size_mm", h},
+                         {"trapped_voids", nlohmann::json::array()},
+                         {"thin_walls", nlohmann::json::array()},
+                         {"small_holes", nlohmann::json::array()},
+                         {"overhang_area_mm2", pr.overhang_area_mm2},
+                         {"down_facing_area_mm2", pr.down_facing_area_mm2}};
+    auto list = [&](const char* key, const std::vector<PrintFeature>& features) {
+      for (const PrintFeature& f : features)
+        j["printability"][key].push_back({{"volume_mm3", f.volume_mm3}, {"location", {f.location_mm.x, f.location_mm.y, f.location_mm.z}}});
+    };
+    list("trapped_voids", pr.trapped_voids);
+    list("thin_walls", pr.thin_walls);
+    list("small_holes", pr.small_holes);
+    printable = pr.ok();
+    // Copies at the top level, where scripts look first.
+    j["trapped_voids"] = j["printability"]["trapped_voids"];
+    j["thin_walls"] = j["printability"]["thin_walls"];
+    j["small_holes"] = j["printability"]["small_holes"];
+  }
   if (flags.json) {
-    nlohmann::json j = check_report_json(report);
-    j["file"] = path;
     std::cout << j.dump(2) << "\n";
   } else if (!flags.quiet) {
     std::cout << path << ":\n" << check_report_text(report);
+    if (print.enabled) {
+      auto show = [](const char* what, const std::vector<PrintFeature>& features) {
+        for (const PrintFeature& f : features)
+          std::printf("  %s: %.4g mm3 at (%.4g, %.4g, %.4g)\n", what, f.volume_mm3, f.location_mm.x, f.location_mm.y, f.location_mm.z);
+      };
+      show("trapped void", pr.trapped_voids);
+      show("thin wall", pr.thin_walls);
+      show("small hole", pr.small_holes);
+      std::printf("  overhang %.4g mm2 of %.4g mm2 facing down\n  %s\n", pr.overhang_area_mm2, pr.down_facing_area_mm2,
+                  printable ? "printable" : "NOT PRINTABLE as it is");
+    }
   }
-  return report.valid() ? kExitOk : kExitCheckFailed;
+  return report.valid() && printable ? kExitOk : kExitCheckFailed;
 }
 
 struct FeaArgs {
@@ -185,6 +256,15 @@ int run_app(int argc, char** argv) {
       "check", "Check a mesh (STL, 3MF, OBJ, PLY) as a printable solid: closed, manifold, outward-oriented,\n"
                "free of self-intersections and degenerate faces, positive volume. Exit 0 only if valid.");
   check->add_option("MESH", mesh_path, "Mesh file")->required();
+  PrintArgs print;
+  check->add_flag("--print", print.enabled, "Also analyse printability: trapped voids, thin walls, small holes, overhang");
+  check->add_option("--min-wall", print.min_wall, "With --print: thinnest wall allowed, mm")->check(CLI::NonNegativeNumber);
+  check->add_option("--min-hole", print.min_hole, "With --print: narrowest hole or channel allowed, mm")->check(CLI::NonNegativeNumber);
+  check->add_option("--build-dir", print.build_dir, "With --print: build direction, x y z -x -y -z or dx,dy,dz (default z)");
+  check->add_option("--critical-angle", print.critical_angle, "With --print: down-facing surface flatter than this is overhang, degrees (45)")
+      ->check(CLI::Range(0.0, 90.0));
+  check->add_option("--voxel-size", print.voxel, "With --print: voxel size of the analysis, mm (default: a quarter of the smallest size)")
+      ->check(CLI::PositiveNumber);
   add_common(check, flags);
   FeaArgs fea_args;
   CLI::App* fea = app.add_subcommand(
@@ -224,7 +304,7 @@ int run_app(int argc, char** argv) {
       run_options.max_memory_bytes = uint64_t(max_memory_gb * 1e9);
       return command_run(recipe, run_options, flags);
     }
-    if (*check) return command_check(mesh_path, flags);
+    if (*check) return command_check(mesh_path, flags, print);
     if (*fea) return command_fea(fea_args, run_options, flags);
     return cifs_command();
   } catch (const Error& e) {

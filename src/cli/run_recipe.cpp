@@ -19,6 +19,9 @@
 #include "solids/budget.h"
 #include "solids/check.h"
 #include "solids/decimate.h"
+#include "solids/infill.h"
+#include "solids/printability.h"
+#include "solids/repair.h"
 #include "solids/extract.h"
 #include "solids/voxelize.h"
 #include "util/system.h"
@@ -70,6 +73,30 @@ auto in_context(const std::string& where, Step&& step) {
   }
 }
 
+// A hull must be a valid closed solid (closed, manifold, outward, no self-intersections) unless
+// the recipe asks for explicit repairs; a broken one is an error that says what is wrong.
+TriMesh checked_hull(TriMesh mesh, const MeshRepair& repair, double voxel_size_mm, const std::string& where) {
+  MeshCheckReport r = check_mesh(mesh);
+  if (r.valid()) return mesh;
+  if (repair.any()) {
+    RepairOptions options;
+    options.weld_mm = repair.weld_mm;
+    options.reorient = repair.reorient;
+    options.close_gaps_mm = repair.close_gaps_mm;
+    mesh = repair_mesh(mesh, options, voxel_size_mm);
+    r = check_mesh(mesh);
+    if (r.valid()) return mesh;
+  }
+  // Overlapping shells and crossings are resolved as a union by the level set when allowed.
+  if (repair.allow_overlaps && r.closed() && r.non_manifold_edges == 0 && r.triangles > 0 && r.non_finite_vertices == 0)
+    return mesh;
+  std::string problems;
+  for (const std::string& p : r.problems()) problems += (problems.empty() ? "" : "; ") + p;
+  throw InvalidInput(where + " is not a valid closed solid: " + problems + (repair.any() ? " (after the repairs asked for)" : "") +
+                     ". Repair it explicitly with \"repair\": {\"weld_mm\", \"reorient\", \"close_gaps_mm\", "
+                     "\"allow_overlaps\"}, or thicken an open surface with type \"surface\"");
+}
+
 void import_meshes(Recipe& recipe, uint64_t budget) {
   const fs::path base = fs::path(recipe.file).parent_path();
   for (RecipeInput& in : recipe.inputs) {
@@ -93,21 +120,42 @@ void import_meshes(Recipe& recipe, uint64_t budget) {
     }
     for (Vec3d& p : mesh.positions_mm) p = p * in.mesh_scale + in.mesh_translate_mm;
     if (in.mesh_role == RecipeInput::MeshRole::kSolid) {
-      // The level-set conversion needs a closed surface; it tolerates orientation errors and
-      // overlapping shells, so only openness is fatal here.
-      CheckOptions quick;
-      quick.self_intersections = false;
-      MeshCheckReport r = check_mesh(mesh, quick);
-      if (!r.closed() || r.degenerate_faces == r.triangles) {
-        std::string message = where + ": " + file.string() + " is not a closed mesh (" +
-                              std::to_string(r.boundary_edges) + " boundary edges); use type \"surface\" with " +
-                              "\"thickness_mm\" to thicken an open surface";
-        throw InvalidInput(message);
-      }
-      in.geometry.solids.push_back(std::move(mesh));
+      in.geometry.solids.push_back(checked_hull(std::move(mesh), in.repair, recipe.voxel_size_mm, where + ": " + file.string()));
     } else {
       in.geometry.surfaces.push_back(ThickSurface{std::move(mesh), in.surface_thickness_mm});
     }
+  }
+  // Hulls given inline are held to the same standard.
+  for (RecipeInput& in : recipe.inputs)
+    if (in.type == "mesh" && in.mesh_file.empty())
+      for (TriMesh& m : in.geometry.solids)
+        m = checked_hull(std::move(m), in.repair, recipe.voxel_size_mm, recipe.file + ": " + in.json_path);
+}
+
+// Inputs built from other inputs (lattices fitted to a hull, grades by depth in it), in order.
+void resolve_inputs(Recipe& recipe, const VolumeOptions& vopt) {
+  auto find = [&](const std::string& name) -> const RecipeInput& {
+    for (const RecipeInput& in : recipe.inputs)
+      if (in.name == name) return in;
+    throw std::logic_error("unknown input " + name);
+  };
+  RecipeContext context;
+  context.box_of = [&](const std::string& name) { return bounding_box(find(name).geometry); };
+  context.depth_in = [&](const std::string& name, double max_depth) {
+    // A field for grading needs no finer voxels than a tenth of its range.
+    VolumeOptions wide;
+    wide.voxel_size_mm = std::max(vopt.voxel_size_mm, max_depth / 10);
+    wide.half_band_voxels = max_depth / wide.voxel_size_mm + 2;
+    auto volume = std::make_shared<Volume>(voxelize(find(name).geometry, wide));
+    return std::function<double(const Vec3d&)>(
+        [volume, max_depth](const Vec3d& p) { return std::clamp(-volume->distance_at(p), 0.0, max_depth); });
+  };
+  for (RecipeInput& in : recipe.inputs) {
+    if (!in.resolve) continue;
+    for (const std::string& dep : in.depends_on)
+      if (find(dep).resolve)
+        throw InvalidInput(recipe.file + ": " + in.json_path + ": \"" + dep + "\" is itself built from another input");
+    in.resolve(in, context);
   }
 }
 
@@ -200,7 +248,8 @@ Estimate estimate(const Recipe& recipe, const Plan& plan, const VolumeOptions& v
       if (op.kind == RecipeOperation::Kind::kUnion) o.box.expand(objects[name].box);
     }
     VolumeOptions work = vopt;
-    if (op.kind == RecipeOperation::Kind::kOffset || op.kind == RecipeOperation::Kind::kShell) {
+    if (op.kind == RecipeOperation::Kind::kOffset || op.kind == RecipeOperation::Kind::kShell ||
+        op.kind == RecipeOperation::Kind::kInfill) {
       // Goes through the operand's surface mesh and a band as wide as the distance.
       double d = op.kind == RecipeOperation::Kind::kOffset ? std::fabs(op.distance_mm) : op.thickness_mm;
       mesh_of(first.voxels);
@@ -230,6 +279,59 @@ std::string refusal(const std::string& what, uint64_t need, uint64_t budget, con
          " (now " + fixed(vopt.voxel_size_mm, 4) + " mm)";
 }
 
+nlohmann::json features_json(const std::vector<PrintFeature>& features) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const PrintFeature& f : features)
+    list.push_back({{"volume_mm3", f.volume_mm3}, {"location", {f.location_mm.x, f.location_mm.y, f.location_mm.z}}});
+  return list;
+}
+
+nlohmann::json printability_json(const PrintabilityReport& r) {
+  return {{"trapped_voids", features_json(r.trapped_voids)},
+          {"thin_walls", features_json(r.thin_walls)},
+          {"small_holes", features_json(r.small_holes)},
+          {"overhang_area_mm2", r.overhang_area_mm2},
+          {"down_facing_area_mm2", r.down_facing_area_mm2}};
+}
+
+// Printability of an object before it is meshed; with "fix", drain holes are drilled from its
+// trapped voids (the object changes) and it is analysed again.
+nlohmann::json check_printability(Volume& volume, const PrintabilitySettings& settings, std::vector<std::string>& problems) {
+  PrintabilityOptions options;
+  options.min_wall_mm = settings.min_wall_mm;
+  options.min_hole_mm = settings.min_hole_mm;
+  options.build_direction = settings.build_direction;
+  options.critical_angle_deg = settings.critical_angle_deg;
+  PrintabilityReport report = analyze_printability(volume, options);
+  size_t drilled = 0;
+  if (settings.on_failure == PrintabilitySettings::OnFailure::kFix && !report.trapped_voids.empty()) {
+    drilled = report.trapped_voids.size();
+    volume = drill_drain_holes(volume, report.trapped_voids, settings.drain_hole_mm, options, settings.drain_down);
+    report = analyze_printability(volume, options);
+  }
+  nlohmann::json j = printability_json(report);
+  j["drain_holes"] = drilled;
+  if (settings.on_failure != PrintabilitySettings::OnFailure::kReport) {
+    if (!report.trapped_voids.empty()) problems.push_back(std::to_string(report.trapped_voids.size()) + " trapped voids (powder or resin cannot drain)");
+    if (!report.thin_walls.empty()) problems.push_back(std::to_string(report.thin_walls.size()) + " walls thinner than " + fixed(settings.min_wall_mm, 4) + " mm");
+    if (!report.small_holes.empty()) problems.push_back(std::to_string(report.small_holes.size()) + " holes narrower than " + fixed(settings.min_hole_mm, 4) + " mm");
+  }
+  return j;
+}
+
+// Adds an object's printability findings and relative density to an output's report entry.
+void annotate(nlohmann::json& entry, const nlohmann::json& printability, const std::vector<std::string>& problems,
+              const std::map<std::string, double>& hull_volume, const std::string& object) {
+  if (!printability.is_null()) entry["printability"] = printability;
+  for (const std::string& p : problems) {
+    entry["checks"]["problems"].push_back(p);
+    entry["checks"]["valid"] = false;
+  }
+  auto hull = hull_volume.find(object);
+  if (hull != hull_volume.end() && hull->second > 0 && entry.contains("volume_mm3"))
+    entry["relative_density"] = entry["volume_mm3"].get<double>() / hull->second;
+}
+
 // Refuses, before meshing, a surface whose mesh and checks would not fit next to what is in use.
 void require_mesh_memory(const Volume& v, uint64_t budget, const std::string& what, const VolumeOptions& vopt) {
   uint64_t need = estimate_from_voxels(v.active_voxel_count(), vopt).mesh_bytes + current_memory_bytes();
@@ -253,6 +355,7 @@ RunResult run_recipe(const std::string& recipe_path, const RunOptions& options) 
   const uint64_t budget = options.max_memory_bytes ? options.max_memory_bytes : available_memory_bytes() / 2;
 
   import_meshes(recipe, budget);
+  resolve_inputs(recipe, vopt);
   for (const RecipeInput& in : recipe.inputs)
     in_context(recipe.file + ": " + in.json_path, [&] { validate(in.geometry); });
   Plan plan = make_plan(recipe);
@@ -290,6 +393,7 @@ RunResult run_recipe(const std::string& recipe_path, const RunOptions& options) 
   try {
     // Volumes, built in recipe order and released after their last use.
     std::map<std::string, Volume> volumes;
+    std::map<std::string, double> hull_volume;  // of infill operations, for their relative density
     std::map<std::string, int> uses = plan.uses;
     auto take = [&](const std::string& name) {
       Volume v = volumes.at(name);
@@ -328,6 +432,15 @@ RunResult run_recipe(const std::string& recipe_path, const RunOptions& options) 
           require_mesh_memory(v, budget, recipe.file + ": " + op.json_path, vopt);
           v = shell(v, op.thickness_mm);
           break;
+        case RecipeOperation::Kind::kInfill: {
+          Volume hull = take(op.operands[0]), structure = take(op.operands[1]);
+          require_mesh_memory(hull, budget, recipe.file + ": " + op.json_path, vopt);
+          // Fused by a voxel unless told otherwise (and never through the whole skin).
+          double fuse = op.distance_mm >= 0 ? op.distance_mm : std::min(vopt.voxel_size_mm, 0.5 * op.thickness_mm);
+          v = in_context(recipe.file + ": " + op.json_path, [&] { return infill(hull, structure, op.thickness_mm, fuse); });
+          hull_volume[op.name] = hull.voxel_volume_mm3();
+          break;
+        }
       }
       volumes[op.name] = v;
     }
@@ -340,8 +453,15 @@ RunResult run_recipe(const std::string& recipe_path, const RunOptions& options) 
     for (const std::string& object : objects) {
       timer.start("mesh");
       Volume volume = take(object);
-      const uint64_t voxels = volume.active_voxel_count();
       require_mesh_memory(volume, budget, recipe.file + ": meshing \"" + object + "\"", vopt);
+      nlohmann::json printability;
+      std::vector<std::string> print_problems;
+      if (recipe.printability.enabled) {
+        timer.start("printability");
+        printability = check_printability(volume, recipe.printability, print_problems);
+        timer.start("mesh");
+      }
+      const uint64_t voxels = volume.active_voxel_count();
       TriMesh mesh = extract_surface(volume);
       volume = Volume();
       if (mesh.triangles.empty())
@@ -403,8 +523,9 @@ RunResult run_recipe(const std::string& recipe_path, const RunOptions& options) 
         entry["format"] = out.format;
         entry["object"] = out.object;
         entry["voxels"] = voxels;
+        annotate(entry, printability, print_problems, hull_volume, out.object);
         outputs.push_back(entry);
-        all_valid = all_valid && fea.valid();
+        all_valid = all_valid && entry["checks"]["valid"].get<bool>();
       }
       mesh = TriMesh();
       decimated.clear();
@@ -421,8 +542,9 @@ RunResult run_recipe(const std::string& recipe_path, const RunOptions& options) 
         entry["part_name"] = w.out->part_name;
         entry["voxels"] = voxels;
         if (w.out->decimate_mm > 0) entry["decimated_mm"] = w.out->decimate_mm;
+        annotate(entry, printability, print_problems, hull_volume, w.out->object);
         outputs.push_back(entry);
-        all_valid = all_valid && report.valid();
+        all_valid = all_valid && entry["checks"]["valid"].get<bool>();
       }
       for (const RecipeOutput& out : recipe.outputs)
         if (out.object == object)

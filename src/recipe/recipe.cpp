@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "cifs/solid_input.h"
+#include "infill/recipe_input.h"
 #include "errors.h"
 
 namespace lacuna {
@@ -46,6 +47,14 @@ TriMesh inline_mesh(const JsonObject& o) {
 
 // A mesh input: a file to import, or vertices and triangles inline.
 void parse_mesh_source(const JsonObject& o, RecipeInput& in, bool surface) {
+  if (o.has("repair")) {
+    JsonObject r = o.object("repair");
+    r.allow_only({"weld_mm", "reorient", "close_gaps_mm", "allow_overlaps"});
+    in.repair.weld_mm = r.positive_length_or("weld_mm", 0.0);
+    in.repair.reorient = r.boolean_or("reorient", false);
+    in.repair.close_gaps_mm = r.positive_length_or("close_gaps_mm", 0.0);
+    in.repair.allow_overlaps = r.boolean_or("allow_overlaps", false);
+  }
   bool has_file = o.has("file"), has_inline = o.has("positions_mm") || o.has("triangles");
   if (has_file == has_inline) o.fail("", "give either \"file\" or \"positions_mm\" and \"triangles\"");
   in.mesh_scale = o.has("scale") ? o.positive_length("scale") : 1.0;
@@ -66,6 +75,7 @@ void parse_mesh_source(const JsonObject& o, RecipeInput& in, bool surface) {
 
 void register_builtin_types() {
   cifs::register_recipe_inputs();
+  register_infill_inputs();
   register_input_type({"sphere", {"center_mm", "radius_mm"}, [](const JsonObject& o, RecipeInput& in) {
                          in.geometry.spheres.centers_mm.push_back(o.vec3_or("center_mm", Vec3d{}));
                          in.geometry.spheres.radii_mm.push_back(o.positive_length("radius_mm"));
@@ -139,7 +149,7 @@ void register_builtin_types() {
                          if (s.minor_radius_mm >= s.radius_mm) o.fail("minor_radius_mm", "expected less than major_radius_mm");
                          in.geometry.shapes.push_back(s);
                        }});
-  register_input_type({"mesh", {"file", "positions_mm", "triangles", "scale", "translate_mm"},
+  register_input_type({"mesh", {"file", "positions_mm", "triangles", "scale", "translate_mm", "repair"},
                        [](const JsonObject& o, RecipeInput& in) { parse_mesh_source(o, in, false); }});
   register_input_type({"surface", {"file", "positions_mm", "triangles", "scale", "translate_mm", "thickness_mm"},
                        [](const JsonObject& o, RecipeInput& in) { parse_mesh_source(o, in, true); }});
@@ -207,7 +217,7 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
   nlohmann::json root = parse_json_text(text, path);
   JsonObject top(root, path, "");
   top.allow_only({"lacuna_recipe", "name", "description", "voxel_size_mm", "band_voxels", "seed", "inputs",
-                  "operations", "outputs"});
+                  "operations", "outputs", "printability"});
   Recipe recipe;
   recipe.file = path;
   if (top.has("lacuna_recipe") && top.unsigned_integer_or("lacuna_recipe", 1) != 1)
@@ -248,13 +258,26 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
     recipe.inputs.push_back(std::move(input));
   }
 
+  for (const RecipeInput& in : recipe.inputs)
+    for (const std::string& dep : in.depends_on) {
+      bool found = false;
+      for (const RecipeInput& other : recipe.inputs) found = found || (other.name == dep && &other != &in);
+      if (!found) {
+        std::vector<std::string> input_names;
+        for (const RecipeInput& other : recipe.inputs) input_names.push_back(other.name);
+        std::string suggestion = closest_match(dep, input_names);
+        throw InvalidInput(path + ": " + in.json_path + ": \"" + dep + "\" is not another input" +
+                           (suggestion.empty() ? std::string() : "; did you mean \"" + suggestion + "\"?"));
+      }
+    }
+
   if (top.has("operations")) {
     const nlohmann::json& ops = top.required("operations");
     if (!ops.is_array()) top.fail("operations", "expected a list of operations");
     const std::map<std::string, RecipeOperation::Kind> kinds = {
         {"union", RecipeOperation::Kind::kUnion},       {"difference", RecipeOperation::Kind::kDifference},
         {"intersection", RecipeOperation::Kind::kIntersection}, {"offset", RecipeOperation::Kind::kOffset},
-        {"shell", RecipeOperation::Kind::kShell}};
+        {"shell", RecipeOperation::Kind::kShell},       {"infill", RecipeOperation::Kind::kInfill}};
     for (size_t i = 0; i < ops.size(); ++i) {
       JsonObject o(ops[i], path, "operations[" + std::to_string(i) + "]");
       RecipeOperation op;
@@ -277,22 +300,35 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
       bool unary = op.kind == RecipeOperation::Kind::kOffset || op.kind == RecipeOperation::Kind::kShell;
       if (op.kind == RecipeOperation::Kind::kOffset) o.allow_only({"name", "op", "of", "distance_mm"});
       else if (op.kind == RecipeOperation::Kind::kShell) o.allow_only({"name", "op", "of", "thickness_mm"});
+      else if (op.kind == RecipeOperation::Kind::kInfill) o.allow_only({"name", "op", "hull", "structure", "skin_mm", "fuse_mm"});
       else o.allow_only({"name", "op", "of"});
-      const nlohmann::json& of = o.required("of");
-      if (unary) {
-        if (!of.is_string()) o.fail("of", "expected the name of one input or earlier operation");
-        op.operands.push_back(of.get<std::string>());
-      } else {
-        if (!of.is_array() || of.size() < 2) o.fail("of", "expected a list of at least two names");
-        for (const auto& n : of) {
-          if (!n.is_string()) o.fail("of", "expected names (strings)");
-          op.operands.push_back(n.get<std::string>());
+      if (op.kind == RecipeOperation::Kind::kInfill) {
+        op.operands = {o.string("hull"), o.string("structure")};
+        op.thickness_mm = o.positive_length("skin_mm");
+        op.distance_mm = -1;
+        if (o.has("fuse_mm")) {
+          op.distance_mm = o.number("fuse_mm");
+          if (op.distance_mm < 0 || op.distance_mm >= op.thickness_mm)
+            o.fail("fuse_mm", "expected at least 0 and less than skin_mm");
+        }
+      }
+      if (op.kind != RecipeOperation::Kind::kInfill) {
+        const nlohmann::json& of = o.required("of");
+        if (unary) {
+          if (!of.is_string()) o.fail("of", "expected the name of one input or earlier operation");
+          op.operands.push_back(of.get<std::string>());
+        } else {
+          if (!of.is_array() || of.size() < 2) o.fail("of", "expected a list of at least two names");
+          for (const auto& n : of) {
+            if (!n.is_string()) o.fail("of", "expected names (strings)");
+            op.operands.push_back(n.get<std::string>());
+          }
         }
       }
       for (const std::string& ref : op.operands) {
         if (names.count(ref)) continue;
         std::string suggestion = closest_match(ref, std::vector<std::string>(names.begin(), names.end()));
-        o.fail("of", "\"" + ref + "\" is not an input or an earlier operation" +
+        o.fail(op.kind == RecipeOperation::Kind::kInfill ? "hull" : "of", "\"" + ref + "\" is not an input or an earlier operation" +
                          (suggestion.empty() ? std::string() : "; did you mean \"" + suggestion + "\"?"));
       }
       if (op.kind == RecipeOperation::Kind::kOffset) {
@@ -365,6 +401,28 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
     }
     out.part_name = o.string_or("name", out.object);
     recipe.outputs.push_back(std::move(out));
+  }
+
+  if (top.has("printability")) {
+    JsonObject pr = top.object("printability");
+    pr.allow_only({"min_wall_mm", "min_hole_mm", "build_direction", "critical_angle_deg", "on_failure", "drain_hole_mm",
+                   "drain"});
+    PrintabilitySettings& p = recipe.printability;
+    p.enabled = true;
+    p.min_wall_mm = pr.positive_length_or("min_wall_mm", 0.0);
+    p.min_hole_mm = pr.positive_length_or("min_hole_mm", 0.0);
+    p.build_direction = pr.direction_or("build_direction", Vec3d{0, 0, 1});
+    p.critical_angle_deg = pr.number_or("critical_angle_deg", 45);
+    if (p.critical_angle_deg < 0 || p.critical_angle_deg > 90) pr.fail("critical_angle_deg", "expected 0 to 90 degrees");
+    std::string on_failure = pr.string_or("on_failure", "error");
+    if (on_failure == "error") p.on_failure = PrintabilitySettings::OnFailure::kError;
+    else if (on_failure == "fix") p.on_failure = PrintabilitySettings::OnFailure::kFix;
+    else if (on_failure == "report") p.on_failure = PrintabilitySettings::OnFailure::kReport;
+    else pr.fail("on_failure", "expected \"error\", \"fix\" or \"report\", got \"" + on_failure + "\"");
+    p.drain_hole_mm = pr.positive_length_or("drain_hole_mm", 2.0);
+    std::string drain = pr.string_or("drain", "nearest");
+    if (drain != "nearest" && drain != "down") pr.fail("drain", "expected \"nearest\" or \"down\"");
+    p.drain_down = drain == "down";
   }
   return recipe;
 }

@@ -12,6 +12,23 @@
 
 namespace lacuna {
 
+// What the runner offers inputs that depend on other inputs (lattices fitted to a hull, grades by
+// depth inside it), once every mesh is imported.
+struct RecipeContext {
+  std::function<Box3(const std::string& input)> box_of;  // bounding box of another input (mm)
+  // Distance inside another input's solid (mm, 0 outside), exact up to `max_depth_mm`.
+  std::function<std::function<double(const Vec3d&)>(const std::string& input, double max_depth_mm)> depth_in;
+};
+
+// Explicit repairs of an imported hull (none by default: a broken hull is an error).
+struct MeshRepair {
+  double weld_mm = 0;
+  bool reorient = false;
+  double close_gaps_mm = 0;
+  bool allow_overlaps = false;  // accept self-intersecting or overlapping shells (resolved as a union)
+  bool any() const { return weld_mm > 0 || reorient || close_gaps_mm > 0; }
+};
+
 // A named input: geometry given inline or produced by a generator, or a mesh file to import.
 struct RecipeInput {
   enum class MeshRole { kNone, kSolid, kSurface };
@@ -25,16 +42,31 @@ struct RecipeInput {
   double surface_thickness_mm = 0; // for kSurface
   double mesh_scale = 1.0;         // applied to the imported mesh, then the translation
   Vec3d mesh_translate_mm;
+  MeshRepair repair;
+  std::vector<std::string> depends_on;  // inputs this one is built from
+  std::function<void(RecipeInput& self, const RecipeContext& context)> resolve;  // fills geometry
 };
 
 struct RecipeOperation {
-  enum class Kind { kUnion, kDifference, kIntersection, kOffset, kShell };
+  enum class Kind { kUnion, kDifference, kIntersection, kOffset, kShell, kInfill };
   std::string name;
   std::string json_path;
   Kind kind = Kind::kUnion;
-  std::vector<std::string> operands;  // names of inputs or earlier operations
-  double distance_mm = 0;             // offset: > 0 grows, < 0 shrinks
-  double thickness_mm = 0;            // shell: wall thickness inward
+  std::vector<std::string> operands;  // names of inputs or earlier operations (infill: hull, structure)
+  double distance_mm = 0;             // offset: > 0 grows, < 0 shrinks; infill: fusing depth (< 0: a voxel)
+  double thickness_mm = 0;            // shell: wall thickness inward; infill: skin thickness
+};
+
+// Printability checks applied to every exported object, and what to do when one fails.
+struct PrintabilitySettings {
+  bool enabled = false;
+  double min_wall_mm = 0;
+  double min_hole_mm = 0;
+  Vec3d build_direction{0, 0, 1};
+  double critical_angle_deg = 45;
+  enum class OnFailure { kError, kFix, kReport } on_failure = OnFailure::kError;
+  double drain_hole_mm = 2.0;      // fix: diameter of the holes drilled from trapped voids
+  bool drain_down = false;         // fix: drill along -build_direction instead of the shortest way
 };
 
 // Settings of a tetrahedral (FEA) output.
@@ -69,6 +101,7 @@ struct Recipe {
   std::vector<RecipeInput> inputs;
   std::vector<RecipeOperation> operations;
   std::vector<RecipeOutput> outputs;
+  PrintabilitySettings printability;
 };
 
 // Reads and validates a recipe file. Throws IoError if it cannot be read, InvalidInput naming the

@@ -1,0 +1,56 @@
+#include "solids/components.h"
+
+#include <numeric>
+
+namespace lacuna {
+
+std::vector<MeshComponent> mesh_components(const TriMesh& m) {
+  std::vector<uint32_t> parent(m.positions_mm.size());
+  std::iota(parent.begin(), parent.end(), 0u);
+  auto find = [&](uint32_t v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  auto join = [&](uint32_t a, uint32_t b) {
+    a = find(a);
+    b = find(b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  };
+  for (const auto& t : m.triangles) {
+    join(t[0], t[1]);
+    join(t[1], t[2]);
+  }
+  std::vector<int> index(m.positions_mm.size(), -1);
+  std::vector<MeshComponent> out;
+  std::vector<Vec3d> moment;  // sum of det * (a + b + c), for the volume centroid
+  for (uint32_t f = 0; f < m.triangles.size(); ++f) {
+    const auto& t = m.triangles[f];
+    uint32_t root = find(t[0]);
+    if (index[root] < 0) {
+      index[root] = int(out.size());
+      out.emplace_back();
+      moment.emplace_back();
+    }
+    MeshComponent& c = out[size_t(index[root])];
+    const Vec3d &a = m.positions_mm[t[0]], &b = m.positions_mm[t[1]], &d = m.positions_mm[t[2]];
+    c.triangles.push_back(f);
+    const double det = dot(a, cross(b, d));
+    c.signed_volume_mm3 += det / 6.0;
+    moment[size_t(index[root])] += (a + b + d) * det;
+    c.area_mm2 += 0.5 * norm(cross(b - a, d - a));
+    c.box.expand(a);
+    c.box.expand(b);
+    c.box.expand(d);
+  }
+  for (size_t i = 0; i < out.size(); ++i) {
+    MeshComponent& c = out[i];
+    if (c.signed_volume_mm3 != 0) {
+      c.centroid_mm = moment[i] / (24.0 * c.signed_volume_mm3);
+    } else {
+      c.centroid_mm = (c.box.min + c.box.max) * 0.5;
+    }
+  }
+  return out;
+}
+
+}  // namespace lacuna

@@ -1,0 +1,22 @@
+// Connected components of a triangle mesh (through shared vertices) and their measures.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "geometry.h"
+
+namespace lacuna {
+
+struct MeshComponent {
+  std::vector<uint32_t> triangles;  // indices into the mesh's triangles
+  double signed_volume_mm3 = 0;     // > 0 for an outward shell, < 0 for a cavity's
+  double area_mm2 = 0;
+  Vec3d centroid_mm;                // of the enclosed volume (of the vertices when it is zero)
+  Box3 box;
+};
+
+// The components in order of their first triangle.
+std::vector<MeshComponent> mesh_components(const TriMesh& mesh);
+
+}  // namespace lacuna

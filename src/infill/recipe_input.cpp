@@ -1,0 +1,83 @@
+#include "infill/recipe_input.h"
+
+#include <memory>
+
+#include "errors.h"
+#include "infill/lattice.h"
+#include "recipe/recipe.h"
+
+namespace lacuna {
+
+void register_infill_inputs() {
+  register_input_type(
+      {"lattice",
+       {"cell", "period_mm", "strut_radius_mm", "min_mm", "max_mm", "fit_to", "grade"},
+       [](const JsonObject& o, RecipeInput& in) {
+         auto options = std::make_shared<LatticeOptions>();
+         std::string cell = o.string_or("cell", "cubic");
+         if (cell == "cubic") options->cell = LatticeOptions::Cell::kCubic;
+         else if (cell == "bcc") options->cell = LatticeOptions::Cell::kBodyCentred;
+         else o.fail("cell", "expected \"cubic\" or \"bcc\", got \"" + cell + "\"");
+         options->period_mm = o.positive_length("period_mm");
+         const bool fitted = o.has("fit_to");
+         if (fitted == (o.has("min_mm") || o.has("max_mm"))) o.fail("", "give either \"fit_to\" or \"min_mm\" and \"max_mm\"");
+         if (o.has("grade")) {
+           JsonObject g = o.object("grade");
+           g.allow_only({"radius_min_mm", "radius_max_mm", "field", "axis", "from_mm", "to_mm", "points_mm", "falloff_mm",
+                         "depth_mm"});
+           options->radius_min_mm = g.positive_length("radius_min_mm");
+           options->radius_max_mm = g.positive_length("radius_max_mm");
+           GradeField& f = options->grade;
+           std::string field = g.string("field");
+           if (field == "ramp") {
+             f.kind = GradeField::Kind::kRamp;
+             f.axis = g.direction_or("axis", Vec3d{0, 0, 1});
+             f.from_mm = g.number("from_mm");
+             f.to_mm = g.number("to_mm");
+             if (f.from_mm == f.to_mm) g.fail("to_mm", "expected a value different from from_mm");
+           } else if (field == "points") {
+             f.kind = GradeField::Kind::kPoints;
+             f.points_mm = g.vec3_list("points_mm");
+             if (f.points_mm.empty()) g.fail("points_mm", "expected at least one point");
+             f.falloff_mm = g.positive_length("falloff_mm");
+           } else if (field == "depth") {
+             f.kind = GradeField::Kind::kDepth;
+             f.depth_mm = g.positive_length("depth_mm");
+             if (!fitted) g.fail("field", "a depth grade needs \"fit_to\": the hull it is measured in");
+           } else {
+             g.fail("field", "expected \"ramp\", \"points\" or \"depth\", got \"" + field + "\"");
+           }
+           if (o.has("strut_radius_mm")) o.fail("strut_radius_mm", "give the radii in \"grade\" when grading");
+         } else {
+           options->radius_mm = o.positive_length("strut_radius_mm");
+         }
+         if (!fitted) {
+           Box3 box;
+           box.expand(o.vec3("min_mm"));
+           box.expand(o.vec3("max_mm"));
+           Vec3d lo = o.vec3("min_mm"), hi = o.vec3("max_mm");
+           if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z)) o.fail("max_mm", "expected max_mm > min_mm on every axis");
+           try {
+             in.geometry.tubes = lattice_tubes(box, *options);
+           } catch (const InvalidInput& e) {
+             o.fail("", e.what());
+           }
+           return;
+         }
+         const std::string hull = o.string("fit_to");
+         in.depends_on.push_back(hull);
+         const std::string where = o.file() + ": " + o.path();
+         in.resolve = [options, hull, where](RecipeInput& self, const RecipeContext& context) {
+           LatticeOptions resolved = *options;
+           if (resolved.grade.kind == GradeField::Kind::kDepth)
+             resolved.grade.depth_of = context.depth_in(hull, resolved.grade.depth_mm);
+           try {
+             self.geometry.tubes = lattice_tubes(context.box_of(hull), resolved);
+           } catch (const InvalidInput& e) {
+             throw InvalidInput(where + ": " + e.what());
+           }
+         };
+       }});
+}
+
+}  // namespace lacuna

@@ -1,0 +1,195 @@
+// Hull infill and printability: skins, lattices, grading, trapped voids and drain holes, thin
+// walls, broken hulls, against closed forms.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "errors.h"
+#include "infill/lattice.h"
+#include "solids/check.h"
+#include "solids/extract.h"
+#include "solids/infill.h"
+#include "solids/printability.h"
+#include "solids/repair.h"
+#include "solids/voxelize.h"
+
+namespace lacuna {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+Volume box(const Vec3d& lo, const Vec3d& hi, double h) {
+  GeometrySet set;
+  Shape s;
+  s.kind = Shape::Kind::kBox;
+  s.center_mm = (lo + hi) * 0.5;
+  s.half_size_mm = (hi - lo) * 0.5;
+  set.shapes.push_back(s);
+  return voxelize(set, VolumeOptions{h, 3.0});
+}
+
+Volume ball(const Vec3d& c, double r, double h) {
+  GeometrySet set;
+  set.spheres.centers_mm = {c};
+  set.spheres.radii_mm = {r};
+  return voxelize(set, VolumeOptions{h, 3.0});
+}
+
+double mesh_volume(const Volume& v) { return check_mesh(extract_surface(v)).volume_mm3; }
+
+TEST(Printability, SphereVoidIsTrappedUntilDrained) {
+  const double h = 0.2, o = 0.1;  // faces half a voxel off the grid
+  Volume part = subtract(box({o, o, o}, {20 + o, 20 + o, 20 + o}, h), ball({10 + o, 10 + o, 10 + o}, 5, h));
+  PrintabilityOptions options;
+  PrintabilityReport before = analyze_printability(part, options);
+  ASSERT_EQ(before.trapped_voids.size(), 1u);
+  const double sphere = 4.0 / 3.0 * kPi * 125;
+  EXPECT_NEAR(before.trapped_voids[0].volume_mm3, sphere, 0.01 * sphere);
+  EXPECT_LT(norm(before.trapped_voids[0].location_mm - Vec3d{10 + o, 10 + o, 10 + o}), 0.05);
+
+  Volume drained = drill_drain_holes(part, before.trapped_voids, 2.0, options, /*downwards=*/true);
+  EXPECT_TRUE(analyze_printability(drained, options).trapped_voids.empty());
+  MeshCheckReport check = check_mesh(extract_surface(drained));
+  EXPECT_TRUE(check.valid());
+  EXPECT_EQ(check.genus, 0);
+  // The channel of radius 1 runs from the sphere's surface to the bottom face, 10 mm from the
+  // centre: its volume is the cylinder's less the sphere's cap inside it,
+  // pi r^2 10 - (2 pi / 3)(R^3 - (R^2 - r^2)^(3/2)).
+  const double hole = kPi * 10 - 2 * kPi / 3 * (125 - std::pow(24.0, 1.5));
+  EXPECT_NEAR(mesh_volume(part) - check.volume_mm3, hole, 0.03 * hole);
+}
+
+TEST(Printability, ThinPlateIsReportedThickPlateIsNot) {
+  const double h = 0.05, o = 0.025;
+  PrintabilityOptions options;
+  options.min_wall_mm = 0.4;
+  Volume thin = box({o, o, o}, {6 + o, 6 + o, 0.3 + o}, h);
+  PrintabilityReport r = analyze_printability(thin, options);
+  ASSERT_EQ(r.thin_walls.size(), 1u);
+  EXPECT_NEAR(r.thin_walls[0].volume_mm3, 6 * 6 * 0.3, 0.05 * 6 * 6 * 0.3);
+  Volume thick = box({o, o, o}, {6 + o, 6 + o, 0.5 + o}, h);
+  EXPECT_TRUE(analyze_printability(thick, options).thin_walls.empty());
+}
+
+TEST(Printability, NarrowSlotIsASmallHole) {
+  const double h = 0.05, o = 0.025;
+  Volume block = box({o, o, o}, {6 + o, 4 + o, 3 + o}, h);
+  Volume slot = box({2 + o, -1 + o, 1 + o}, {2.3 + o, 5 + o, 4 + o}, h);  // 0.3 mm wide, through
+  PrintabilityOptions options;
+  options.min_hole_mm = 0.5;
+  PrintabilityReport r = analyze_printability(subtract(block, slot), options);
+  ASSERT_EQ(r.small_holes.size(), 1u);
+  EXPECT_NEAR(r.small_holes[0].volume_mm3, 0.3 * 4 * 2, 0.1 * 0.3 * 4 * 2);
+  // Well below the slot's width (within a voxel or two of it the closing cannot decide).
+  options.min_hole_mm = 0.1;
+  EXPECT_TRUE(analyze_printability(subtract(block, slot), options).small_holes.empty());
+}
+
+TEST(Printability, OverhangOfABoxOnThePlate) {
+  // A 10 mm cube standing on the plate has no overhang; turned upside down over a pillar, its
+  // bottom (100 mm^2 less the pillar's 4 mm^2) is overhang.
+  const double h = 0.1, o = 0.05;
+  PrintabilityOptions options;
+  EXPECT_NEAR(analyze_printability(box({o, o, o}, {10 + o, 10 + o, 10 + o}, h), options).overhang_area_mm2, 0, 1e-9);
+  Volume table = unite(box({o, o, 5 + o}, {10 + o, 10 + o, 10 + o}, h), box({4 + o, 4 + o, o}, {6 + o, 6 + o, 5.2 + o}, h));
+  EXPECT_NEAR(analyze_printability(table, options).overhang_area_mm2, 96, 0.02 * 96);
+}
+
+TEST(Infill, CubeHullWithLatticeSkinAndOnePart) {
+  const double h = 0.2, o = 0.1, a = 20, s = 1.5;
+  Volume hull = box({o, o, o}, {a + o, a + o, a + o}, h);
+  // The skin alone: the cube minus the cube eroded by s.
+  const double skin_exact = a * a * a - std::pow(a - 2 * s, 3);
+  EXPECT_NEAR(mesh_volume(shell(hull, s)), skin_exact, 0.01 * skin_exact);
+  LatticeOptions lattice;
+  lattice.period_mm = 5;
+  lattice.radius_mm = 0.6;
+  Box3 region;
+  region.expand(Vec3d{o, o, o});
+  region.expand(Vec3d{a + o, a + o, a + o});
+  GeometrySet struts;
+  struts.tubes = lattice_tubes(region, lattice);
+  Volume part = infill(hull, voxelize(struts, VolumeOptions{h, 3.0}), s, h);
+  MeshCheckReport r = check_mesh(extract_surface(part));
+  EXPECT_TRUE(r.valid()) << ::testing::PrintToString(r.problems());
+  // One solid: every other surface component is a cavity (the space between skin and struts,
+  // sealed inside it).
+  PrintabilityReport p = analyze_printability(part, PrintabilityOptions{});
+  EXPECT_EQ(r.components - p.trapped_voids.size(), 1u);
+  EXPECT_GT(r.volume_mm3, skin_exact);
+}
+
+TEST(Infill, GradedLatticeDensityRisesAlongTheRamp) {
+  const double h = 0.1, o = 0.05, a = 20;
+  LatticeOptions lattice;
+  lattice.period_mm = 4;
+  lattice.radius_min_mm = 0.3;
+  lattice.radius_max_mm = 1.1;
+  lattice.grade.kind = GradeField::Kind::kRamp;
+  lattice.grade.axis = {0, 0, 1};
+  lattice.grade.from_mm = 0;
+  lattice.grade.to_mm = a;
+  Box3 region;
+  region.expand(Vec3d{o, o, o});
+  region.expand(Vec3d{a + o, a + o, a + o});
+  GeometrySet struts;
+  struts.tubes = lattice_tubes(region, lattice);
+  Volume part = infill(box({o, o, o}, {a + o, a + o, a + o}, h), voxelize(struts, VolumeOptions{h, 3.0}), 1.0, h);
+  // Density of the whole periods inside the skin (z from 4 to 16 mm), period by period, sampled
+  // on a 0.1 mm grid.
+  std::vector<double> density;
+  for (int slab = 1; slab < 4; ++slab) {
+    long inside = 0, total = 0;
+    for (double z = slab * 4 + 0.05; z < (slab + 1) * 4; z += 0.1)
+      for (double y = 1.55; y < a - 1.5; y += 0.1)
+        for (double x = 1.55; x < a - 1.5; x += 0.1) {
+          total++;
+          inside += part.distance_at({x, y, z}) < 0;
+        }
+    density.push_back(double(inside) / double(total));
+  }
+  for (size_t i = 1; i < density.size(); ++i) EXPECT_GT(density[i], density[i - 1]) << "slab " << i;
+  EXPECT_GT(density.back(), 2 * density.front());
+}
+
+TEST(Infill, RepairsOnlyWhenAskedAndTheyWork) {
+  // A cube with one face's triangles flipped and one vertex duplicated a hair away.
+  TriMesh cube;
+  for (int i = 0; i < 8; ++i) cube.positions_mm.push_back({i & 1 ? 10.0 : 0.0, i & 2 ? 10.0 : 0.0, i & 4 ? 10.0 : 0.0});
+  cube.triangles = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
+                    {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
+  TriMesh broken = cube;
+  std::swap(broken.triangles[2][1], broken.triangles[2][2]);
+  std::swap(broken.triangles[3][1], broken.triangles[3][2]);
+  broken.positions_mm.push_back({10.0, 10.0, 10.0 + 1e-6});
+  broken.triangles[11][1] = 8;  // uses the near-duplicate of vertex 7
+  EXPECT_FALSE(check_mesh(broken).valid());
+  RepairOptions fix;
+  fix.weld_mm = 1e-4;
+  fix.reorient = true;
+  TriMesh repaired = repair_mesh(broken, fix, 0.1);
+  MeshCheckReport r = check_mesh(repaired);
+  EXPECT_TRUE(r.valid()) << ::testing::PrintToString(r.problems());
+  EXPECT_NEAR(r.volume_mm3, 1000, 1e-6);
+  // The top replaced by a lid 0.3 mm smaller all round: a crack of 0.3 mm, closed by a
+  // morphological closing of 0.5 mm.
+  TriMesh cracked = cube;
+  cracked.triangles.erase(cracked.triangles.begin() + 2, cracked.triangles.begin() + 4);
+  const uint32_t lid = uint32_t(cracked.positions_mm.size());
+  for (Vec3d p : {Vec3d{0.3, 0.3, 10}, Vec3d{9.7, 0.3, 10}, Vec3d{9.7, 9.7, 10}, Vec3d{0.3, 9.7, 10}}) cracked.positions_mm.push_back(p);
+  cracked.triangles.push_back({lid, lid + 1, lid + 2});
+  cracked.triangles.push_back({lid, lid + 2, lid + 3});
+  EXPECT_FALSE(check_mesh(cracked).closed());
+  RepairOptions close;
+  close.close_gaps_mm = 0.5;
+  MeshCheckReport closed = check_mesh(repair_mesh(cracked, close, 0.1));
+  EXPECT_TRUE(closed.valid()) << ::testing::PrintToString(closed.problems());
+  EXPECT_NEAR(closed.volume_mm3, 1000, 0.02 * 1000);
+  // A hole wider than the closing is refused, not turned into a thin cup.
+  TriMesh open = cube;
+  open.triangles.erase(open.triangles.begin() + 2, open.triangles.begin() + 4);
+  EXPECT_THROW(repair_mesh(open, close, 0.1), InvalidInput);
+}
+
+}  // namespace
+}  // namespace lacuna
