@@ -15,7 +15,7 @@ constexpr double kPi = 3.14159265358979323846;
 // Regions of `residue` that are real features rather than the slivers an opening or closing of
 // radius r trims off edges: volume over surface at least r / 4 (a slab of thickness t has t / 2; a
 // 90-degree edge sliver 0.06 r), and at least a voxel of volume.
-std::vector<PrintFeature> features(const Volume& residue, double r) {
+std::vector<PrintFeature> features(const Volume& residue, double r, TriMesh* kept = nullptr) {
   std::vector<PrintFeature> out;
   if (residue.empty()) return out;
   const double h = residue.voxel_size_mm();
@@ -24,6 +24,20 @@ std::vector<PrintFeature> features(const Volume& residue, double r) {
     if (c.signed_volume_mm3 <= h * h * h) continue;
     if (c.signed_volume_mm3 / c.area_mm2 < 0.25 * r) continue;
     out.push_back(PrintFeature{c.signed_volume_mm3, c.centroid_mm, c.box});
+    if (!kept) continue;
+    std::vector<int64_t> index(surface.positions_mm.size(), -1);
+    for (uint32_t f : c.triangles) {
+      std::array<uint32_t, 3> t{};
+      for (int k = 0; k < 3; ++k) {
+        uint32_t v = surface.triangles[f][size_t(k)];
+        if (index[v] < 0) {
+          index[v] = int64_t(kept->positions_mm.size());
+          kept->positions_mm.push_back(surface.positions_mm[v]);
+        }
+        t[size_t(k)] = uint32_t(index[v]);
+      }
+      kept->triangles.push_back(t);
+    }
   }
   return out;
 }
@@ -45,7 +59,7 @@ PrintabilityReport analyze_printability(const Volume& part, const PrintabilityOp
   if (options.min_wall_mm > 0) {
     const double r = 0.5 * options.min_wall_mm;
     Volume opened = offset(offset(part, -r), r);
-    report.thin_walls = features(subtract(part, opened), r);
+    report.thin_walls = features(subtract(part, opened), r, &report.thin_wall_surface);
   }
   if (options.min_hole_mm > 0) {
     const double r = 0.5 * options.min_hole_mm;
@@ -73,6 +87,12 @@ PrintabilityReport analyze_printability(const Volume& part, const PrintabilityOp
     if (down > critical && !on_plate) report.overhang_area_mm2 += 0.5 * twice;
   }
   return report;
+}
+
+Volume thicken_thin_walls(const Volume& part, const PrintabilityReport& report, double min_wall_mm) {
+  if (report.thin_wall_surface.triangles.empty()) return part;
+  Volume regions = mesh_to_volume(report.thin_wall_surface, part.options());
+  return unite(part, offset(regions, 0.5 * min_wall_mm));
 }
 
 Volume drill_drain_holes(const Volume& part, const std::vector<PrintFeature>& voids, double diameter_mm,

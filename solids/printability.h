@@ -30,6 +30,7 @@ struct PrintabilityReport {
   std::vector<PrintFeature> trapped_voids;  // cavities with no path to the outside
   double overhang_area_mm2 = 0;             // down-facing surface below the critical angle
   double down_facing_area_mm2 = 0;          // all surface facing down
+  TriMesh thin_wall_surface;                // the surfaces of the thin-wall regions (for thickening)
   bool ok() const { return thin_walls.empty() && small_holes.empty() && trapped_voids.empty(); }
 };
 
@@ -41,6 +42,10 @@ struct PrintabilityReport {
 // voids are the inward-facing shells of the solid's surface (cavities), with the volume they
 // enclose. Overhang from the surface's down-facing triangles.
 PrintabilityReport analyze_printability(const Volume& part, const PrintabilityOptions& options);
+
+// The solid with every thin-wall region grown by half the minimum wall, so it is at least that
+// thick; the rest of the solid is untouched.
+Volume thicken_thin_walls(const Volume& part, const PrintabilityReport& report, double min_wall_mm);
 
 // The solid with a drain hole of the given diameter drilled from every trapped void to the
 // outside: a straight channel from the void's centroid to the nearest point of the outer surface,

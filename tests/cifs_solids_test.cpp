@@ -56,6 +56,24 @@ TEST(CifsSolids, SierpinskiTetrahedronHalvesItsVolumePerLevel) {
   }
 }
 
+TEST(CifsSolids, FitToBoxScalesAndCentresTheAttractor) {
+  // The Menger sponge is its unit cube; fitted to a 30 x 20 x 40 box it becomes a cube of side 20
+  // (the smallest ratio) centred in the box.
+  cifs::Cifs c = placed("menger_sponge", 1, 0);
+  Box3 target;
+  target.expand(Vec3d{-5, 0, 10});
+  target.expand(Vec3d{25, 20, 50});
+  cifs::Cifs fitted = cifs::fit_to_box(c, target);
+  Box3 got;
+  cifs::for_each_piece(fitted, 2, [&](const cifs::Piece& piece) {
+    for (Eigen::Index i = 0; i < piece.vertices->cols(); ++i)
+      got.expand(Vec3d{(*piece.vertices)(0, i), (*piece.vertices)(1, i), (*piece.vertices)(2, i)});
+  });
+  const Vec3d lo{0, 0, 20}, hi{20, 20, 40};
+  EXPECT_LT(norm(got.min - lo), 1e-9);
+  EXPECT_LT(norm(got.max - hi), 1e-9);
+}
+
 TEST(CifsSolids, StreamedBatchesGiveTheSameSolid) {
   cifs::Cifs c = placed("menger_sponge", 9, 0.05);
   cifs::SolidOptions whole, pieces;

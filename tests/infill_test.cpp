@@ -71,6 +71,29 @@ TEST(Printability, ThinPlateIsReportedThickPlateIsNot) {
   EXPECT_TRUE(analyze_printability(thick, options).thin_walls.empty());
 }
 
+TEST(Printability, ThinPlateIsThickenedByTheMinimumWall) {
+  // A 0.3 mm plate under a 0.4 mm minimum wall grows by half the wall on every side: 0.3 + 0.4 mm
+  // thick, and no longer thin. A thick block beside it is untouched.
+  const double h = 0.05, o = 0.025;
+  PrintabilityOptions options;
+  options.min_wall_mm = 0.4;
+  Volume plate = box({o, o, o}, {4 + o, 4 + o, 0.3 + o}, h);
+  Volume block = box({6 + o, o, o}, {9 + o, 3 + o, 3 + o}, h);
+  Volume part = unite(plate, block);
+  PrintabilityReport r = analyze_printability(part, options);
+  ASSERT_EQ(r.thin_walls.size(), 1u);
+  Volume fixed = thicken_thin_walls(part, r, options.min_wall_mm);
+  EXPECT_TRUE(analyze_printability(fixed, options).thin_walls.empty());
+  MeshCheckReport check = check_mesh(extract_surface(fixed));
+  ASSERT_TRUE(check.valid());
+  EXPECT_EQ(check.components, 2u);
+  // The plate's offset by 0.2 mm: (4.4 x 4.4 x 0.7) less the squared-off edges and corners an
+  // offset rounds: box + faces + quarter cylinders + eighth spheres (Steiner's formula).
+  const double d = 0.2, a = 4, b = 4, c = 0.3;
+  const double grown = a * b * c + 2 * d * (a * b + b * c + a * c) + kPi * d * d * (a + b + c) + 4.0 / 3.0 * kPi * d * d * d;
+  EXPECT_NEAR(check.volume_mm3, grown + 27, 0.02 * (grown + 27));
+}
+
 TEST(Printability, NarrowSlotIsASmallHole) {
   const double h = 0.05, o = 0.025;
   Volume block = box({o, o, o}, {6 + o, 4 + o, 3 + o}, h);

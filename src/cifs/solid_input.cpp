@@ -42,6 +42,27 @@ std::vector<std::pair<int, int>> primitive_edges(const State& s) {
 
 }  // namespace
 
+Cifs fit_to_box(const Cifs& cifs_in, const Box3& target) {
+  Cifs c = cifs_in;
+  complete_primitives(c.automaton);
+  // The pieces of a few levels bound the attractor closely (they contain it).
+  Box3 source;
+  const int level = int(std::min<uint64_t>(3, count_pieces(c.automaton, 3) > 100000 ? 1 : 3));
+  for_each_piece(c, level, [&](const Piece& piece) {
+    for (Eigen::Index i = 0; i < piece.vertices->cols(); ++i) source.expand(column(*piece.vertices, i));
+  });
+  double scale = HUGE_VAL;
+  for (int k = 0; k < 3; ++k)
+    if (source.size()[k] > 1e-12 * norm(source.size())) scale = std::min(scale, target.size()[k] / source.size()[k]);
+  if (!std::isfinite(scale) || !(scale > 0)) throw InvalidInput("cannot fit an attractor without extent to a box");
+  const Vec3d shift = (target.min + target.max) * 0.5 - (source.min + source.max) * 0.5 * scale;
+  for (Eigen::Index i = 0; i < c.control_points.cols(); ++i) {
+    const double w = c.rational ? c.control_points(3, i) : 1.0;
+    c.control_points.block<3, 1>(0, i) = c.control_points.block<3, 1>(0, i) * scale + Eigen::Vector3d(shift.x, shift.y, shift.z) * w;
+  }
+  return c;
+}
+
 GeometrySet attractor_geometry(const Cifs& cifs_in, int level, const SolidOptions& options) {
   auto c = std::make_shared<Cifs>(cifs_in);
   complete_primitives(c->automaton);
@@ -143,7 +164,7 @@ GeometrySet attractor_geometry(const Cifs& cifs_in, int level, const SolidOption
 void register_recipe_inputs() {
   register_input_type(
       {"cifs",
-       {"system", "level", "as", "radius_mm", "thickness_mm"},
+       {"system", "level", "as", "radius_mm", "thickness_mm", "fit_to"},
        [](const JsonObject& o, RecipeInput& in) {
          Cifs c = parse_system(o.required("system"), o.file(), o.path_of("system"));
          uint64_t level = o.unsigned_integer_or("level", 3);
@@ -157,13 +178,26 @@ void register_recipe_inputs() {
          else if (!as.empty()) o.fail("as", "expected \"tubes\", \"shell\", \"cells\" or \"edges\", got \"" + as + "\"");
          if (o.has("radius_mm")) options.radius_mm = o.positive_length("radius_mm");
          if (o.has("thickness_mm")) options.thickness_mm = o.positive_length("thickness_mm");
-         try {
-           in.geometry = attractor_geometry(c, int(level), options);
-         } catch (const InvalidInput& e) {
-           o.fail("", e.what());
-         } catch (const ResourceLimit& e) {
-           throw ResourceLimit(o.file() + ": " + o.path() + ": " + e.what());
+         const std::string where = o.file() + ": " + o.path();
+         auto build = [c, level, options, where](const Cifs& placed) {
+           try {
+             return attractor_geometry(placed, int(level), options);
+           } catch (const InvalidInput& e) {
+             throw InvalidInput(where + ": " + e.what());
+           } catch (const ResourceLimit& e) {
+             throw ResourceLimit(where + ": " + e.what());
+           }
+         };
+         if (!o.has("fit_to")) {
+           in.geometry = build(c);
+           return;
          }
+         // Scaled (uniformly) and moved so the attractor's box fits the other input's, centred.
+         const std::string target = o.string("fit_to");
+         in.depends_on.push_back(target);
+         in.resolve = [c, target, build](RecipeInput& self, const RecipeContext& context) {
+           self.geometry = build(fit_to_box(c, context.box_of(target)));
+         };
        }});
 }
 

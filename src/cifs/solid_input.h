@@ -22,6 +22,9 @@ struct SolidOptions {
 // Throws InvalidInput when the options do not fit the system's primitives.
 GeometrySet attractor_geometry(const Cifs& cifs, int level, const SolidOptions& options);
 
+// The system scaled uniformly and moved so that its attractor's box fits `box`, centred.
+Cifs fit_to_box(const Cifs& cifs, const Box3& box);
+
 // Registers the "cifs" recipe input type (called once by the recipe reader).
 void register_recipe_inputs();
 

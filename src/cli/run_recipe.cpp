@@ -303,14 +303,23 @@ nlohmann::json check_printability(Volume& volume, const PrintabilitySettings& se
   options.build_direction = settings.build_direction;
   options.critical_angle_deg = settings.critical_angle_deg;
   PrintabilityReport report = analyze_printability(volume, options);
-  size_t drilled = 0;
-  if (settings.on_failure == PrintabilitySettings::OnFailure::kFix && !report.trapped_voids.empty()) {
-    drilled = report.trapped_voids.size();
-    volume = drill_drain_holes(volume, report.trapped_voids, settings.drain_hole_mm, options, settings.drain_down);
-    report = analyze_printability(volume, options);
+  size_t drilled = 0, thickened = 0;
+  if (settings.on_failure == PrintabilitySettings::OnFailure::kFix && !report.ok()) {
+    // Thin walls first (growing them can seal nothing new), then drain holes.
+    if (!report.thin_walls.empty()) {
+      thickened = report.thin_walls.size();
+      volume = thicken_thin_walls(volume, report, settings.min_wall_mm);
+      report = analyze_printability(volume, options);
+    }
+    if (!report.trapped_voids.empty()) {
+      drilled = report.trapped_voids.size();
+      volume = drill_drain_holes(volume, report.trapped_voids, settings.drain_hole_mm, options, settings.drain_down);
+      report = analyze_printability(volume, options);
+    }
   }
   nlohmann::json j = printability_json(report);
   j["drain_holes"] = drilled;
+  j["thickened_walls"] = thickened;
   if (settings.on_failure != PrintabilitySettings::OnFailure::kReport) {
     if (!report.trapped_voids.empty()) problems.push_back(std::to_string(report.trapped_voids.size()) + " trapped voids (powder or resin cannot drain)");
     if (!report.thin_walls.empty()) problems.push_back(std::to_string(report.thin_walls.size()) + " walls thinner than " + fixed(settings.min_wall_mm, 4) + " mm");
