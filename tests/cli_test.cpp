@@ -427,6 +427,10 @@ std::vector<BadCase> bad_cases() {
       {"fea_bad_quality", R"({"inputs": {"x": )" + ok_input + R"(}, "outputs": [{"of": "x", "file": "x.inp", "fea": {"quality": 0.5}}]})", "", "", "outputs[0].fea.quality"},
       {"fea_bad_element", R"({"inputs": {"x": )" + ok_input + R"(}, "outputs": [{"of": "x", "file": "x.inp", "fea": {"element": "C3D8"}}]})", "", "", "C3D10"},
       {"fea_unknown_region", R"({"inputs": {"x": )" + ok_input + R"(}, "outputs": [{"of": "x", "file": "x.msh", "fea": {"regions": ["y"]}}]})", "", "", "regions"},
+      {"lattice_conforming_without_hull", with_input(R"({"type": "lattice", "period_mm": 2, "strut_radius_mm": 0.3, "min_mm": [0,0,0], "max_mm": [4,4,4], "layout": "conforming"})"), "", "", "inputs.x.layout"},
+      {"lattice_bad_layout", with_input(R"({"type": "lattice", "period_mm": 2, "strut_radius_mm": 0.3, "min_mm": [0,0,0], "max_mm": [4,4,4], "layout": "conformal"})"), "", "", "\"conforming\""},
+      {"lattice_too_many_levels", with_input(R"({"type": "lattice", "period_mm": 2, "strut_radius_mm": 0.3, "min_mm": [0,0,0], "max_mm": [4,4,4], "grade": {"parameter": "level", "levels": 9, "field": "ramp", "from_mm": 0, "to_mm": 4}})"), "", "", "inputs.x.grade.levels"},
+      {"lattice_level_without_radius", with_input(R"({"type": "lattice", "period_mm": 2, "min_mm": [0,0,0], "max_mm": [4,4,4], "grade": {"parameter": "level", "field": "ramp", "from_mm": 0, "to_mm": 4}})"), "", "", "strut_radius_mm"},
       {"empty_result", R"({"inputs": {"a": {"type": "sphere", "radius_mm": 1}, "b": {"type": "sphere", "center_mm": [9, 0, 0], "radius_mm": 1}}, "operations": [{"name": "i", "op": "intersection", "of": ["a", "b"]}], "outputs": [{"of": "i", "file": "x.stl"}]})", "", "", "empty"},
   };
 }

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
+#include <map>
 
 #include "errors.h"
 #include "infill/lattice.h"
@@ -173,6 +175,100 @@ TEST(Infill, GradedLatticeDensityRisesAlongTheRamp) {
   }
   for (size_t i = 1; i < density.size(); ++i) EXPECT_GT(density[i], density[i - 1]) << "slab " << i;
   EXPECT_GT(density.back(), 2 * density.front());
+}
+
+double total_length(const TubeSet& set) {
+  double sum = 0;
+  for (const Tube& t : set.tubes)
+    for (size_t i = 1; i < t.points_mm.size(); ++i) sum += norm(t.points_mm[i] - t.points_mm[i - 1]);
+  return sum;
+}
+
+TEST(Infill, LevelGradeSplitsTheCellsUpTheRamp) {
+  // Four unit cells along x, a ramp from 0 to 1 over them, one split allowed: the cells whose
+  // centre is above 1/2 (the last two) become 2 x 2 x 2 cells of 0.5 mm. Edge lengths by hand:
+  // the 2 x 1 x 1 unit block has 8 + 6 + 6 = 20 mm of edges, the 4 x 2 x 2 block of half cells
+  // (36 + 30 + 30) x 0.5 = 48 mm; the unit edges on the face they share are distinct struts.
+  LatticeOptions lattice;
+  lattice.period_mm = 1;
+  lattice.radius_mm = 0.1;
+  lattice.graded = LatticeOptions::Graded::kLevel;
+  lattice.levels = 1;
+  lattice.grade.kind = GradeField::Kind::kRamp;
+  lattice.grade.axis = {1, 0, 0};
+  lattice.grade.from_mm = 0;
+  lattice.grade.to_mm = 4;
+  Box3 region;
+  region.expand(Vec3d{0, 0, 0});
+  region.expand(Vec3d{4, 1, 1});
+  TubeSet struts = lattice_tubes(region, lattice);
+  EXPECT_NEAR(total_length(struts), 68, 1e-9);
+  EXPECT_EQ(struts.tubes.size(), 20u + 96u);
+  for (const Tube& t : struts.tubes) EXPECT_EQ(t.radii_mm.front(), 0.1);
+  // Without the grade: 4 x 1 x 1 unit cells, 16 + 10 + 10 mm.
+  lattice.grade.kind = GradeField::Kind::kNone;
+  EXPECT_NEAR(total_length(lattice_tubes(region, lattice)), 36, 1e-9);
+}
+
+TEST(Infill, ScaledLayoutSpansTheBoxWithWholeCells) {
+  // 10 x 7 x 3 mm at a 3 mm period: 3 x 2 x 1 cells of 10/3 x 3.5 x 3 mm from the box's corner.
+  LatticeOptions lattice;
+  lattice.period_mm = 3;
+  lattice.radius_mm = 0.2;
+  lattice.layout = LatticeOptions::Layout::kScaled;
+  Box3 region;
+  region.expand(Vec3d{0.3, -1, 2});
+  region.expand(Vec3d{10.3, 6, 5});
+  TubeSet struts = lattice_tubes(region, lattice);
+  // x edges 3 x 3 x 2 of 10/3, y edges 4 x 2 x 2 of 3.5, z edges 4 x 3 x 1 of 3.
+  EXPECT_NEAR(total_length(struts), 60 + 56 + 36, 1e-9);
+  Box3 nodes;
+  for (const Tube& t : struts.tubes)
+    for (const Vec3d& p : t.points_mm) nodes.expand(p);
+  EXPECT_LT(norm(nodes.min - region.min), 1e-12);
+  EXPECT_LT(norm(nodes.max - region.max), 1e-12);
+}
+
+TEST(Infill, ConformingLatticeEndsOnTheInsetSurface) {
+  // A sphere hull of radius 9 with an inset of 1: every strut end lies inside radius 8, the ends
+  // moved there lie on it, no strut runs between two moved ends, and the struts are one graph.
+  const Vec3d c{0.37, 0.21, 0.13};
+  const double radius = 9, inset = 1;
+  LatticeOptions lattice;
+  lattice.period_mm = 2;
+  lattice.radius_mm = 0.3;
+  lattice.layout = LatticeOptions::Layout::kConforming;
+  lattice.conform_inset_mm = inset;
+  lattice.signed_distance_mm = [&](const Vec3d& p) { return norm(p - c) - radius; };
+  Box3 region;
+  region.expand(c - Vec3d{radius, radius, radius});
+  region.expand(c + Vec3d{radius, radius, radius});
+  TubeSet struts = lattice_tubes(region, lattice);
+  ASSERT_GT(struts.tubes.size(), 100u);
+  std::map<std::array<long, 3>, size_t> ids;
+  std::vector<size_t> parent;
+  auto id = [&](const Vec3d& p) {
+    std::array<long, 3> key{std::lround(p.x * 1e6), std::lround(p.y * 1e6), std::lround(p.z * 1e6)};
+    auto it = ids.find(key);
+    if (it != ids.end()) return it->second;
+    parent.push_back(parent.size());
+    return ids[key] = parent.size() - 1;
+  };
+  std::function<size_t(size_t)> root = [&](size_t i) { return parent[i] == i ? i : parent[i] = root(parent[i]); };
+  size_t on_surface = 0;
+  for (const Tube& t : struts.tubes) {
+    const double ra = norm(t.points_mm.front() - c), rb = norm(t.points_mm.back() - c);
+    EXPECT_LE(ra, radius - inset + 1e-7);
+    EXPECT_LE(rb, radius - inset + 1e-7);
+    const bool a_moved = std::abs(ra - (radius - inset)) < 1e-7, b_moved = std::abs(rb - (radius - inset)) < 1e-7;
+    EXPECT_FALSE(a_moved && b_moved);
+    on_surface += a_moved + b_moved;
+    parent[root(id(t.points_mm.front()))] = root(id(t.points_mm.back()));
+  }
+  EXPECT_GT(on_surface, 50u);
+  size_t roots = 0;
+  for (size_t i = 0; i < parent.size(); ++i) roots += root(i) == i;
+  EXPECT_EQ(roots, 1u);
 }
 
 TEST(Infill, RepairsOnlyWhenAskedAndTheyWork) {

@@ -150,6 +150,15 @@ void resolve_inputs(Recipe& recipe, const VolumeOptions& vopt) {
     return std::function<double(const Vec3d&)>(
         [volume, max_depth](const Vec3d& p) { return std::clamp(-volume->distance_at(p), 0.0, max_depth); });
   };
+  context.signed_distance_in = [&](const std::string& name, double inside, double outside) {
+    // Fine enough to place nodes within a few percent of a cell, no finer than the part's voxels.
+    const double range = std::max(inside, outside);
+    VolumeOptions wide;
+    wide.voxel_size_mm = std::max(vopt.voxel_size_mm, range / 20);
+    wide.half_band_voxels = range / wide.voxel_size_mm + 2;
+    auto volume = std::make_shared<Volume>(voxelize(find(name).geometry, wide));
+    return std::function<double(const Vec3d&)>([volume](const Vec3d& p) { return volume->distance_at(p); });
+  };
   for (RecipeInput& in : recipe.inputs) {
     if (!in.resolve) continue;
     for (const std::string& dep : in.depends_on)

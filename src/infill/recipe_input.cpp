@@ -11,7 +11,7 @@ namespace lacuna {
 void register_infill_inputs() {
   register_input_type(
       {"lattice",
-       {"cell", "period_mm", "strut_radius_mm", "min_mm", "max_mm", "fit_to", "grade"},
+       {"cell", "period_mm", "strut_radius_mm", "min_mm", "max_mm", "fit_to", "grade", "layout", "inset_mm"},
        [](const JsonObject& o, RecipeInput& in) {
          auto options = std::make_shared<LatticeOptions>();
          std::string cell = o.string_or("cell", "cubic");
@@ -21,12 +21,37 @@ void register_infill_inputs() {
          options->period_mm = o.positive_length("period_mm");
          const bool fitted = o.has("fit_to");
          if (fitted == (o.has("min_mm") || o.has("max_mm"))) o.fail("", "give either \"fit_to\" or \"min_mm\" and \"max_mm\"");
+         const std::string layout = o.string_or("layout", "tiled");
+         if (layout == "tiled") options->layout = LatticeOptions::Layout::kTiled;
+         else if (layout == "scaled") options->layout = LatticeOptions::Layout::kScaled;
+         else if (layout == "conforming") options->layout = LatticeOptions::Layout::kConforming;
+         else o.fail("layout", "expected \"tiled\", \"scaled\" or \"conforming\", got \"" + layout + "\"");
+         const bool conforming = options->layout == LatticeOptions::Layout::kConforming;
+         if (conforming && !fitted) o.fail("layout", "a conforming lattice needs \"fit_to\": the hull it conforms to");
+         if (o.has("inset_mm")) {
+           if (!conforming) o.fail("inset_mm", "only a conforming lattice has an inset");
+           options->conform_inset_mm = o.number("inset_mm");
+           if (!(options->conform_inset_mm >= 0)) o.fail("inset_mm", "expected a depth of at least 0 mm");
+         }
+         bool radius_given = true;
          if (o.has("grade")) {
            JsonObject g = o.object("grade");
-           g.allow_only({"radius_min_mm", "radius_max_mm", "field", "axis", "from_mm", "to_mm", "points_mm", "falloff_mm",
-                         "depth_mm"});
-           options->radius_min_mm = g.positive_length("radius_min_mm");
-           options->radius_max_mm = g.positive_length("radius_max_mm");
+           g.allow_only({"parameter", "radius_min_mm", "radius_max_mm", "levels", "field", "axis", "from_mm", "to_mm",
+                         "points_mm", "falloff_mm", "depth_mm"});
+           const std::string parameter = g.string_or("parameter", "radius");
+           if (parameter == "radius") {
+             options->graded = LatticeOptions::Graded::kRadius;
+             options->radius_min_mm = g.positive_length("radius_min_mm");
+             options->radius_max_mm = g.positive_length("radius_max_mm");
+             radius_given = false;
+           } else if (parameter == "level") {
+             options->graded = LatticeOptions::Graded::kLevel;
+             const uint64_t levels = g.unsigned_integer_or("levels", 1);
+             if (levels < 1 || levels > 6) g.fail("levels", "expected 1 to 6 splits of a cell");
+             options->levels = int(levels);
+           } else {
+             g.fail("parameter", "expected \"radius\" or \"level\", got \"" + parameter + "\"");
+           }
            GradeField& f = options->grade;
            std::string field = g.string("field");
            if (field == "ramp") {
@@ -47,10 +72,9 @@ void register_infill_inputs() {
            } else {
              g.fail("field", "expected \"ramp\", \"points\" or \"depth\", got \"" + field + "\"");
            }
-           if (o.has("strut_radius_mm")) o.fail("strut_radius_mm", "give the radii in \"grade\" when grading");
-         } else {
-           options->radius_mm = o.positive_length("strut_radius_mm");
          }
+         if (radius_given) options->radius_mm = o.positive_length("strut_radius_mm");
+         else if (o.has("strut_radius_mm")) o.fail("strut_radius_mm", "give the radii in \"grade\" when grading the radius");
          if (!fitted) {
            Box3 box;
            box.expand(o.vec3("min_mm"));
@@ -71,6 +95,11 @@ void register_infill_inputs() {
            LatticeOptions resolved = *options;
            if (resolved.grade.kind == GradeField::Kind::kDepth)
              resolved.grade.depth_of = context.depth_in(hull, resolved.grade.depth_mm);
+           if (resolved.layout == LatticeOptions::Layout::kConforming) {
+             // Nodes up to a cell outside, and the inset surface, must lie in the field's band.
+             const double period = resolved.period_mm;
+             resolved.signed_distance_mm = context.signed_distance_in(hull, resolved.conform_inset_mm + period, period);
+           }
            try {
              self.geometry.tubes = lattice_tubes(context.box_of(hull), resolved);
            } catch (const InvalidInput& e) {

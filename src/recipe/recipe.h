@@ -18,6 +18,10 @@ struct RecipeContext {
   std::function<Box3(const std::string& input)> box_of;  // bounding box of another input (mm)
   // Distance inside another input's solid (mm, 0 outside), exact up to `max_depth_mm`.
   std::function<std::function<double(const Vec3d&)>(const std::string& input, double max_depth_mm)> depth_in;
+  // Signed distance to another input's surface (mm, negative inside), exact from -inside_mm to
+  // outside_mm.
+  std::function<std::function<double(const Vec3d&)>(const std::string& input, double inside_mm, double outside_mm)>
+      signed_distance_in;
 };
 
 // Explicit repairs of an imported hull (none by default: a broken hull is an error).
