@@ -53,4 +53,32 @@ std::vector<MeshComponent> mesh_components(const TriMesh& m) {
   return out;
 }
 
+size_t fill_small_cavities(TriMesh& mesh, double max_volume_mm3) {
+  std::vector<char> drop(mesh.triangles.size(), 0);
+  size_t removed = 0;
+  for (const MeshComponent& c : mesh_components(mesh)) {
+    if (!(c.signed_volume_mm3 < 0 && -c.signed_volume_mm3 < max_volume_mm3)) continue;
+    ++removed;
+    for (uint32_t f : c.triangles) drop[f] = 1;
+  }
+  if (removed == 0) return 0;
+  std::vector<int64_t> index(mesh.positions_mm.size(), -1);
+  TriMesh kept;
+  for (size_t f = 0; f < mesh.triangles.size(); ++f) {
+    if (drop[f]) continue;
+    std::array<uint32_t, 3> t{};
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t v = mesh.triangles[f][size_t(k)];
+      if (index[v] < 0) {
+        index[v] = int64_t(kept.positions_mm.size());
+        kept.positions_mm.push_back(mesh.positions_mm[v]);
+      }
+      t[size_t(k)] = uint32_t(index[v]);
+    }
+    kept.triangles.push_back(t);
+  }
+  mesh = std::move(kept);
+  return removed;
+}
+
 }  // namespace lacuna

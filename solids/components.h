@@ -19,4 +19,10 @@ struct MeshComponent {
 // The components in order of their first triangle.
 std::vector<MeshComponent> mesh_components(const TriMesh& mesh);
 
+// Removes the cavity shells (components of negative volume) enclosing less than `max_volume_mm3`,
+// which fills those pockets, and the vertices left unused; returns how many were removed. A
+// level set meshed at voxel size h cannot resolve a pocket below h^3: where three tubes meet,
+// marching tetrahedra can close one off from sub-voxel sign changes.
+size_t fill_small_cavities(TriMesh& mesh, double max_volume_mm3);
+
 }  // namespace lacuna

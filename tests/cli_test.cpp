@@ -431,8 +431,49 @@ std::vector<BadCase> bad_cases() {
       {"lattice_bad_layout", with_input(R"({"type": "lattice", "period_mm": 2, "strut_radius_mm": 0.3, "min_mm": [0,0,0], "max_mm": [4,4,4], "layout": "conformal"})"), "", "", "\"conforming\""},
       {"lattice_too_many_levels", with_input(R"({"type": "lattice", "period_mm": 2, "strut_radius_mm": 0.3, "min_mm": [0,0,0], "max_mm": [4,4,4], "grade": {"parameter": "level", "levels": 9, "field": "ramp", "from_mm": 0, "to_mm": 4}})"), "", "", "inputs.x.grade.levels"},
       {"lattice_level_without_radius", with_input(R"({"type": "lattice", "period_mm": 2, "min_mm": [0,0,0], "max_mm": [4,4,4], "grade": {"parameter": "level", "field": "ramp", "from_mm": 0, "to_mm": 4}})"), "", "", "strut_radius_mm"},
+      {"curve_bad_kind", with_input(R"({"type": "curve", "kind": "peano", "orders": "1..3", "scale_mm": 5, "radius_mm": 0.3})"), "", "", "inputs.x.kind"},
+      {"curve_radii_count", with_input(R"({"type": "curve", "kind": "hilbert", "orders": "1..3", "scale_mm": 5, "radius_mm": [0.3, 0.2]})"), "", "", "one radius per order"},
+      {"curve_bad_orders", with_input(R"({"type": "curve", "kind": "hilbert", "orders": "3-5", "scale_mm": 5, "radius_mm": 0.3})"), "", "", "FROM..TO"},
+      {"curve_unknown_surface", with_input(R"({"type": "curve", "kind": "hilbert", "orders": [2], "surface": "klein", "scale_mm": 5, "radius_mm": 0.3})"), "", "", "inputs.x.surface"},
+      {"curve_patch_count", with_input(R"({"type": "curve", "kind": "hilbert", "orders": [2], "surface": "bspline", "scale_mm": 1, "radius_mm": 0.3, "patch": {"degree_u": 1, "degree_v": 1, "count_u": 2, "count_v": 2, "control_points_mm": [[0,0,0],[1,0,0],[0,1,0]]}})"), "", "", "count_u x count_v"},
+      {"curve_missing_patch_mesh", with_input(R"({"type": "curve", "kind": "hilbert", "orders": [2], "surface": "mesh", "mesh": "nowhere.stl", "radius_mm": 0.3})"), "", "", "nowhere.stl"},
       {"empty_result", R"({"inputs": {"a": {"type": "sphere", "radius_mm": 1}, "b": {"type": "sphere", "center_mm": [9, 0, 0], "radius_mm": 1}}, "operations": [{"name": "i", "op": "intersection", "of": ["a", "b"]}], "outputs": [{"of": "i", "file": "x.stl"}]})", "", "", "empty"},
   };
+}
+
+TEST(Cli, CurvePointsAndFillRate) {
+  TempDir dir;
+  Result points = lacuna("curve points --kind hilbert --orders 1..3 --json", dir.path());
+  ASSERT_EQ(points.code, 0) << points.err;
+  nlohmann::json p = nlohmann::json::parse(points.out);
+  ASSERT_EQ(p["orders"].size(), 3u);
+  for (size_t k = 1; k <= 3; ++k) {
+    EXPECT_EQ(p["orders"][k - 1]["order"], int(k));
+    EXPECT_EQ(p["orders"][k - 1]["points"].size(), size_t(1) << (2 * k));  // 4^k
+  }
+  // H_1: upper right, upper left, lower left, lower right cell centres.
+  EXPECT_EQ(p["orders"][0]["points"], nlohmann::json::parse("[[0.5,0.5,0.0],[-0.5,0.5,0.0],[-0.5,-0.5,0.0],[0.5,-0.5,0.0]]"));
+  Result sphere = lacuna("curve points --kind sierpinski --orders 2 --surface sphere --json", dir.path());
+  ASSERT_EQ(sphere.code, 0) << sphere.err;
+  for (const auto& q : nlohmann::json::parse(sphere.out)["orders"][0]["points"])
+    EXPECT_NEAR(std::hypot(std::hypot(q[0].get<double>(), q[1].get<double>()), q[2].get<double>()), 1.0, 1e-12);
+  Result csv = lacuna("curve points --kind hilbert3d --orders 2 --csv", dir.path());
+  ASSERT_EQ(csv.code, 0) << csv.err;
+  EXPECT_EQ(std::count(csv.out.begin(), csv.out.end(), '\n'), 1 + 64);
+  // One H_1 stroke set of width 0.5 by hand: three 1 x 0.5 strokes with square caps, overlapping
+  // at the two bends: union 1.75 of the square's 4.
+  Result fill = lacuna("curve fill-rate --kind hilbert --orders 1 --width 0.5 --json", dir.path());
+  ASSERT_EQ(fill.code, 0) << fill.err;
+  nlohmann::json f = nlohmann::json::parse(fill.out);
+  EXPECT_NEAR(f["fill_rate"].get<double>(), 1.75 / 4, 1e-12);
+  EXPECT_NEAR(f["fill_rate_simple"].get<double>(), 3 * 0.5 / 4, 1e-12);
+  EXPECT_EQ(f["segments"], 3);
+  Result bad = lacuna("curve fill-rate --kind peano --orders 1..3", dir.path());
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("--kind"), std::string::npos) << bad.err;
+  Result bad_orders = lacuna("curve points --orders 3..1", dir.path());
+  EXPECT_EQ(bad_orders.code, 2);
+  EXPECT_NE(bad_orders.err.find("--orders"), std::string::npos) << bad_orders.err;
 }
 
 TEST(Cli, MalformedInputIsRejectedWithExitTwoAndNothingWritten) {

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "cli/cifs_commands.h"
+#include "cli/curve_commands.h"
 #include "cli/fea_output.h"
 #include "cli/run_recipe.h"
 #include "export/fea.h"
@@ -287,6 +288,7 @@ int run_app(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   add_common(fea, flags);
   std::function<int()> cifs_command = add_cifs_commands(app);
+  std::function<int()> curve_command = add_curve_commands(app);
 
   try {
     app.parse(argc, argv);
@@ -306,7 +308,8 @@ int run_app(int argc, char** argv) {
     }
     if (*check) return command_check(mesh_path, flags, print);
     if (*fea) return command_fea(fea_args, run_options, flags);
-    return cifs_command();
+    const int code = cifs_command();
+    return code >= 0 ? code : curve_command();
   } catch (const Error& e) {
     std::cerr << "lacuna: error: " << e.what() << "\n";
     return e.exit_code();

@@ -18,8 +18,10 @@
 #include "recipe/recipe.h"
 #include "solids/budget.h"
 #include "solids/check.h"
+#include "solids/components.h"
 #include "solids/decimate.h"
 #include "solids/infill.h"
+#include "solids/parameterize.h"
 #include "solids/printability.h"
 #include "solids/repair.h"
 #include "solids/extract.h"
@@ -158,6 +160,15 @@ void resolve_inputs(Recipe& recipe, const VolumeOptions& vopt) {
     wide.half_band_voxels = range / wide.voxel_size_mm + 2;
     auto volume = std::make_shared<Volume>(voxelize(find(name).geometry, wide));
     return std::function<double(const Vec3d&)>([volume](const Vec3d& p) { return volume->distance_at(p); });
+  };
+  context.surface_of_mesh = [](const std::string& file, const std::string& where) {
+    try {
+      return mesh_patch_map(read_mesh(file), file);
+    } catch (const InvalidInput& e) {
+      throw InvalidInput(where + ": " + e.what());
+    } catch (const IoError& e) {
+      throw IoError(where + ": " + e.what());
+    }
   };
   for (RecipeInput& in : recipe.inputs) {
     if (!in.resolve) continue;
@@ -481,6 +492,8 @@ RunResult run_recipe(const std::string& recipe_path, const RunOptions& options) 
       }
       const uint64_t voxels = volume.active_voxel_count();
       TriMesh mesh = extract_surface(volume);
+      const double h = volume.voxel_size_mm();
+      const size_t filled = fill_small_cavities(mesh, h * h * h);
       volume = Volume();
       if (mesh.triangles.empty())
         throw InvalidInput(recipe.file + ": \"" + object + "\" is empty: nothing is left to export");
@@ -541,6 +554,7 @@ RunResult run_recipe(const std::string& recipe_path, const RunOptions& options) 
         entry["format"] = out.format;
         entry["object"] = out.object;
         entry["voxels"] = voxels;
+        entry["subvoxel_cavities_filled"] = filled;
         annotate(entry, printability, print_problems, hull_volume, out.object);
         outputs.push_back(entry);
         all_valid = all_valid && entry["checks"]["valid"].get<bool>();
@@ -559,6 +573,7 @@ RunResult run_recipe(const std::string& recipe_path, const RunOptions& options) 
         entry["object"] = w.out->object;
         entry["part_name"] = w.out->part_name;
         entry["voxels"] = voxels;
+        entry["subvoxel_cavities_filled"] = filled;
         if (w.out->decimate_mm > 0) entry["decimated_mm"] = w.out->decimate_mm;
         annotate(entry, printability, print_problems, hull_volume, w.out->object);
         outputs.push_back(entry);

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "cifs/solid_input.h"
+#include "curves/recipe_input.h"
 #include "infill/recipe_input.h"
 #include "errors.h"
 
@@ -76,6 +77,7 @@ void parse_mesh_source(const JsonObject& o, RecipeInput& in, bool surface) {
 void register_builtin_types() {
   cifs::register_recipe_inputs();
   register_infill_inputs();
+  curves::register_recipe_inputs();
   register_input_type({"sphere", {"center_mm", "radius_mm"}, [](const JsonObject& o, RecipeInput& in) {
                          in.geometry.spheres.centers_mm.push_back(o.vec3_or("center_mm", Vec3d{}));
                          in.geometry.spheres.radii_mm.push_back(o.positive_length("radius_mm"));

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "curves/curves.h"
 #include "geometry.h"
 #include "recipe/json_fields.h"
 
@@ -22,6 +23,8 @@ struct RecipeContext {
   // outside_mm.
   std::function<std::function<double(const Vec3d&)>(const std::string& input, double inside_mm, double outside_mm)>
       signed_distance_in;
+  // A disk-like mesh patch (a file) flattened onto the square (-1, 1)^2; `where` prefixes errors.
+  std::function<curves::SurfaceMap(const std::string& file, const std::string& where)> surface_of_mesh;
 };
 
 // Explicit repairs of an imported hull (none by default: a broken hull is an error).
