@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "curves/curves.h"
+#include "curves/sweep.h"
 #include "errors.h"
 
 namespace lacuna {
@@ -23,29 +24,11 @@ struct CurveArgs {
 };
 
 std::vector<int> parse_orders(const std::string& text) {
-  std::vector<int> orders;
   try {
-    const size_t dots = text.find("..");
-    if (dots != std::string::npos) {
-      size_t used_a = 0, used_b = 0;
-      const int a = std::stoi(text.substr(0, dots), &used_a), b = std::stoi(text.substr(dots + 2), &used_b);
-      if (used_a != dots || used_b != text.size() - dots - 2 || b < a) throw std::invalid_argument(text);
-      for (int k = a; k <= b; ++k) orders.push_back(k);
-    } else {
-      size_t start = 0;
-      while (start <= text.size()) {
-        const size_t comma = std::min(text.find(',', start), text.size());
-        size_t used = 0;
-        const std::string item = text.substr(start, comma - start);
-        orders.push_back(std::stoi(item, &used));
-        if (used != item.size()) throw std::invalid_argument(item);
-        start = comma + 1;
-      }
-    }
-  } catch (const std::logic_error&) {
-    throw InvalidInput("--orders: expected FROM..TO (e.g. 1..6) or a list such as 3,4,6, got \"" + text + "\"");
+    return curves::parse_orders(text);
+  } catch (const InvalidInput& e) {
+    throw InvalidInput(std::string("--orders: ") + e.what());
   }
-  return orders;
 }
 
 curves::CurveKind kind_of(const std::string& kind) {

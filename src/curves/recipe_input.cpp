@@ -21,17 +21,13 @@ std::vector<int> parse_orders(const JsonObject& o, int most) {
     return int(k);
   };
   if (v.is_string()) {
-    const std::string s = v.get<std::string>();
-    const size_t dots = s.find("..");
+    std::vector<int> given;
     try {
-      if (dots == std::string::npos) throw std::invalid_argument(s);
-      size_t used_a = 0, used_b = 0;
-      const int a = std::stoi(s.substr(0, dots), &used_a), b = std::stoi(s.substr(dots + 2), &used_b);
-      if (used_a != dots || used_b != s.size() - dots - 2 || b < a) throw std::invalid_argument(s);
-      for (int k = a; k <= b; ++k) orders.push_back(check(k));
-    } catch (const std::logic_error&) {
-      o.fail("orders", "expected \"FROM..TO\" (e.g. \"1..5\") or a list of orders, got \"" + s + "\"");
+      given = curves::parse_orders(v.get<std::string>());
+    } catch (const InvalidInput& e) {
+      o.fail("orders", e.what());
     }
+    for (int k : given) orders.push_back(check(k));
   } else if (v.is_array()) {
     for (size_t i = 0; i < v.size(); ++i) {
       if (!v[i].is_number_integer()) o.fail("orders", "expected whole numbers, got " + describe_json_type(v[i]) + " at " + std::to_string(i));

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "errors.h"
 
@@ -14,6 +15,32 @@ SurfaceMap plane_map() {
   m.point = [](double X, double Y) { return Vec3d{X, Y, 0}; };
   m.normal = [](double, double) { return Vec3d{0, 0, 1}; };
   return m;
+}
+
+std::vector<int> parse_orders(const std::string& text) {
+  std::vector<int> orders;
+  try {
+    const size_t dots = text.find("..");
+    if (dots != std::string::npos) {
+      size_t used_a = 0, used_b = 0;
+      const int a = std::stoi(text.substr(0, dots), &used_a), b = std::stoi(text.substr(dots + 2), &used_b);
+      if (used_a != dots || used_b != text.size() - dots - 2 || b < a) throw std::invalid_argument(text);
+      for (int k = a; k <= b; ++k) orders.push_back(k);
+    } else {
+      size_t start = 0;
+      while (start <= text.size()) {
+        const size_t comma = std::min(text.find(',', start), text.size());
+        const std::string item = text.substr(start, comma - start);
+        size_t used = 0;
+        orders.push_back(std::stoi(item, &used));
+        if (used != item.size()) throw std::invalid_argument(item);
+        start = comma + 1;
+      }
+    }
+  } catch (const std::logic_error&) {
+    throw InvalidInput("expected FROM..TO (e.g. 1..6) or a list such as 3,4,6, got \"" + text + "\"");
+  }
+  return orders;
 }
 
 namespace {

@@ -27,6 +27,10 @@ struct Sweep {
   uint64_t segments = 0;               // segments of the mapped polylines
 };
 
+// Orders written "FROM..TO" (e.g. "1..6") or as a list "3,4,6". Throws InvalidInput (the text and
+// what was expected) for anything else, or an empty range.
+std::vector<int> parse_orders(const std::string& text);
+
 // The surface names a sweep understands: "plane" (the square at z = 0), "sphere", "cylinder",
 // "torus", "cone", "cube"; anything else is given as a map (B-spline or mesh patch).
 SurfaceMap plane_map();
