@@ -11,6 +11,8 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+
+#include "fill/fill.h"
 #include <regex>
 #include <sstream>
 #include <string>
@@ -437,6 +439,12 @@ std::vector<BadCase> bad_cases() {
       {"curve_unknown_surface", with_input(R"({"type": "curve", "kind": "hilbert", "orders": [2], "surface": "klein", "scale_mm": 5, "radius_mm": 0.3})"), "", "", "inputs.x.surface"},
       {"curve_patch_count", with_input(R"({"type": "curve", "kind": "hilbert", "orders": [2], "surface": "bspline", "scale_mm": 1, "radius_mm": 0.3, "patch": {"degree_u": 1, "degree_v": 1, "count_u": 2, "count_v": 2, "control_points_mm": [[0,0,0],[1,0,0],[0,1,0]]}})"), "", "", "count_u x count_v"},
       {"curve_missing_patch_mesh", with_input(R"({"type": "curve", "kind": "hilbert", "orders": [2], "surface": "mesh", "mesh": "nowhere.stl", "radius_mm": 0.3})"), "", "", "nowhere.stl"},
+      {"fill_motifs_no_region", with_input(R"({"type": "fill_motifs", "motif": "circle", "height_mm": 1})"), "", "", "\"region\" or \"wallpaper\""},
+      {"fill_motifs_bad_group", with_input(R"({"type": "fill_motifs", "motif": "circle", "height_mm": 1, "wallpaper": {"group": "p7", "a_mm": [10, 0], "b_mm": [0, 10], "cells": [1, 1]}})"), "", "", "inputs.x.wallpaper.group"},
+      {"fill_motifs_bad_c", with_input(R"({"type": "fill_motifs", "motif": "circle", "height_mm": 1, "c": 0.9, "region": {"disk": {"radius_mm": 5}}})"), "", "", "inputs.x.c"},
+      {"fill_motifs_wrap_slanted", with_input(R"({"type": "fill_motifs", "motif": "circle", "height_mm": 1, "wallpaper": {"group": "p1", "a_mm": [10, 3], "b_mm": [0, 10], "cells": [2, 1]}, "wrap": {"depth_mm": 2}})"), "", "", "lie along x"},
+      {"fill_motifs_bad_polygon", with_input(R"({"type": "fill_motifs", "motif": {"polygon": [[0, 0], [1, 1], [1, 0], [0, 1]]}, "height_mm": 1, "region": {"disk": {"radius_mm": 5}}})"), "", "", "inputs.x.motif"},
+      {"fill_spheres_two_regions", with_input(R"({"type": "fill_spheres", "box": {"min_mm": [0,0,0], "max_mm": [5,5,5]}, "sphere": {"radius_mm": 3}})"), "", "", "one region"},
       {"empty_result", R"({"inputs": {"a": {"type": "sphere", "radius_mm": 1}, "b": {"type": "sphere", "center_mm": [9, 0, 0], "radius_mm": 1}}, "operations": [{"name": "i", "op": "intersection", "of": ["a", "b"]}], "outputs": [{"of": "i", "file": "x.stl"}]})", "", "", "empty"},
   };
 }
@@ -474,6 +482,38 @@ TEST(Cli, CurvePointsAndFillRate) {
   Result bad_orders = lacuna("curve points --orders 3..1", dir.path());
   EXPECT_EQ(bad_orders.code, 2);
   EXPECT_NE(bad_orders.err.find("--orders"), std::string::npos) << bad_orders.err;
+}
+
+TEST(Cli, FillPatternJsonSvgAndDeterminism) {
+  TempDir dir;
+  const std::string args = "fill pattern --group p4m --c 1.3 --N 2 --motif circle --count 60 --seed 7 --gap 0.1 --json";
+  Result a = lacuna(args + " --svg " + quote((dir / "p.svg").string()), dir.path());
+  ASSERT_EQ(a.code, 0) << a.err;
+  Result b = lacuna(args, dir.path());
+  ASSERT_EQ(b.code, 0) << b.err;
+  EXPECT_EQ(a.out, b.out);  // same seed, byte-identical placements
+  nlohmann::json j = nlohmann::json::parse(a.out);
+  const size_t k = j["motifs"].size();
+  ASSERT_GT(k, 5u);
+  // The fill fraction is the area rule's partial sum, recomputed here; each motif's area follows it.
+  const double zeta = lacuna::fill::hurwitz_zeta(1.3, 2), cell = 100, region = cell / 8;
+  double sum = 0;
+  for (size_t i = 0; i < k; ++i) {
+    sum += 1 / (zeta * std::pow(2.0 + double(i), 1.3));
+    const nlohmann::json& m = j["motifs"][i];
+    EXPECT_NEAR(m["area"].get<double>() / m["stabilizer_order"].get<double>(), region / (zeta * std::pow(2.0 + double(i), 1.3)), 1e-9);
+  }
+  EXPECT_NEAR(j["fill_fraction"].get<double>(), sum, 1e-12);
+  EXPECT_FALSE(j["stop_reason"].get<std::string>().empty());
+  const std::string svg = read_file(dir / "p.svg");
+  EXPECT_EQ(svg.rfind("<svg", 0), 0u);
+  EXPECT_GT(std::count(svg.begin(), svg.end(), '\n'), long(k));
+  Result bad = lacuna("fill pattern --group p5", dir.path());
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("--group"), std::string::npos) << bad.err;
+  Result bad_lattice = lacuna("fill pattern --group p4 --lattice " + quote("10,0;0,7"), dir.path());
+  EXPECT_EQ(bad_lattice.code, 2);
+  EXPECT_NE(bad_lattice.err.find("p4"), std::string::npos) << bad_lattice.err;
 }
 
 TEST(Cli, MalformedInputIsRejectedWithExitTwoAndNothingWritten) {

@@ -13,6 +13,7 @@
 
 #include "cli/cifs_commands.h"
 #include "cli/curve_commands.h"
+#include "cli/fill_commands.h"
 #include "cli/fea_output.h"
 #include "cli/run_recipe.h"
 #include "export/fea.h"
@@ -289,6 +290,7 @@ int run_app(int argc, char** argv) {
   add_common(fea, flags);
   std::function<int()> cifs_command = add_cifs_commands(app);
   std::function<int()> curve_command = add_curve_commands(app);
+  std::function<int()> fill_command = add_fill_commands(app);
 
   try {
     app.parse(argc, argv);
@@ -308,8 +310,11 @@ int run_app(int argc, char** argv) {
     }
     if (*check) return command_check(mesh_path, flags, print);
     if (*fea) return command_fea(fea_args, run_options, flags);
-    const int code = cifs_command();
-    return code >= 0 ? code : curve_command();
+    for (const auto& command : {cifs_command, curve_command, fill_command}) {
+      const int code = command();
+      if (code >= 0) return code;
+    }
+    return kExitBadInput;
   } catch (const Error& e) {
     std::cerr << "lacuna: error: " << e.what() << "\n";
     return e.exit_code();

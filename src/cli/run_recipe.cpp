@@ -161,6 +161,7 @@ void resolve_inputs(Recipe& recipe, const VolumeOptions& vopt) {
     auto volume = std::make_shared<Volume>(voxelize(find(name).geometry, wide));
     return std::function<double(const Vec3d&)>([volume](const Vec3d& p) { return volume->distance_at(p); });
   };
+  context.volume_of = [&](const std::string& name) { return voxelize(find(name).geometry, vopt).voxel_volume_mm3(); };
   context.surface_of_mesh = [](const std::string& file, const std::string& where) {
     try {
       return mesh_patch_map(read_mesh(file), file);
@@ -609,6 +610,10 @@ RunResult run_recipe(const std::string& recipe_path, const RunOptions& options) 
         {"memory_budget_bytes", budget},
         {"threads", tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)},
     };
+    nlohmann::json inputs_report = nlohmann::json::object();
+    for (const RecipeInput& in : recipe.inputs)
+      if (!in.report.is_null()) inputs_report[in.name] = in.report;
+    if (!inputs_report.empty()) result.report["inputs"] = inputs_report;
     if (!all_valid) {
       transaction.rollback();
       if (created_dir) fs::remove(out_dir, ec);

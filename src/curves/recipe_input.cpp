@@ -101,6 +101,7 @@ void register_recipe_inputs() {
          auto build = [options, where](RecipeInput& self, const SurfaceMap& map, bool on_cube) {
            try {
              Sweep sweep = sweep_curves(options, map, on_cube);
+             self.report = {{"tubes", sweep.tubes.tubes.size()}, {"segments", sweep.segments}};
              self.geometry.tubes = std::move(sweep.tubes);
              self.geometry.surfaces = std::move(sweep.base);
            } catch (const InvalidInput& e) {

@@ -23,6 +23,8 @@ struct RecipeContext {
   // outside_mm.
   std::function<std::function<double(const Vec3d&)>(const std::string& input, double inside_mm, double outside_mm)>
       signed_distance_in;
+  // Volume of another input's solid (mm^3).
+  std::function<double(const std::string& input)> volume_of;
   // A disk-like mesh patch (a file) flattened onto the square (-1, 1)^2; `where` prefixes errors.
   std::function<curves::SurfaceMap(const std::string& file, const std::string& where)> surface_of_mesh;
 };
@@ -52,6 +54,7 @@ struct RecipeInput {
   MeshRepair repair;
   std::vector<std::string> depends_on;  // inputs this one is built from
   std::function<void(RecipeInput& self, const RecipeContext& context)> resolve;  // fills geometry
+  nlohmann::json report;            // what building it found (a fill's count, fill fraction, stop reason)
 };
 
 struct RecipeOperation {
