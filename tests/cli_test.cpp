@@ -445,6 +445,7 @@ std::vector<BadCase> bad_cases() {
       {"fill_motifs_wrap_slanted", with_input(R"({"type": "fill_motifs", "motif": "circle", "height_mm": 1, "wallpaper": {"group": "p1", "a_mm": [10, 3], "b_mm": [0, 10], "cells": [2, 1]}, "wrap": {"depth_mm": 2}})"), "", "", "lie along x"},
       {"fill_motifs_bad_polygon", with_input(R"({"type": "fill_motifs", "motif": {"polygon": [[0, 0], [1, 1], [1, 0], [0, 1]]}, "height_mm": 1, "region": {"disk": {"radius_mm": 5}}})"), "", "", "inputs.x.motif"},
       {"fill_spheres_two_regions", with_input(R"({"type": "fill_spheres", "box": {"min_mm": [0,0,0], "max_mm": [5,5,5]}, "sphere": {"radius_mm": 3}})"), "", "", "one region"},
+      {"fill_spheres_bad_motif", with_input(R"({"type": "fill_spheres", "motif": "dodecahedron", "sphere": {"radius_mm": 3}})"), "", "", "inputs.x.motif"},
       {"empty_result", R"({"inputs": {"a": {"type": "sphere", "radius_mm": 1}, "b": {"type": "sphere", "center_mm": [9, 0, 0], "radius_mm": 1}}, "operations": [{"name": "i", "op": "intersection", "of": ["a", "b"]}], "outputs": [{"of": "i", "file": "x.stl"}]})", "", "", "empty"},
   };
 }

@@ -108,5 +108,31 @@ TEST(FillSolids, PorousBoxPorosityIsThePlacedSphereVolume) {
   EXPECT_NEAR(porosity, placed / 4096, 0.01 * placed / 4096);
 }
 
+TEST(FillSolids, BoxOfRotatedCubeInclusionsHasThePlacedVolume) {
+  // Cubes placed by the volume rule, turned at random, kept apart: as convex cells their union's
+  // volume is the sum of theirs.
+  const std::string text = R"({
+    "inputs": {
+      "cubes": {"type": "fill_spheres", "motif": "cube", "random_rotation": true,
+                "box": {"min_mm": [0.05, 0.05, 0.05], "max_mm": [12.05, 12.05, 12.05]},
+                "c": 1.3, "N": 30, "count": 20, "gap_mm": 0.2, "boundary_gap_mm": 0.3, "seed": 9}
+    },
+    "outputs": [{"of": "cubes", "file": "c.stl"}]
+  })";
+  Recipe recipe = parse_recipe(text, "cubes.json");
+  const RecipeInput& in = recipe.inputs[0];
+  ASSERT_EQ(in.geometry.cells.size(), 1u);
+  const ConvexCells& cells = in.geometry.cells[0];
+  ASSERT_EQ(cells.size(), 20u) << in.report.dump();
+  const double zeta = fill::hurwitz_zeta(1.3, 30);
+  double placed = 0;
+  for (int i = 0; i < 20; ++i) placed += 1728 / (zeta * std::pow(30.0 + i, 1.3));
+  EXPECT_NEAR(in.report["fill_fraction"].get<double>(), placed / 1728, 1e-12);
+  const MeshCheckReport r = check_mesh(extract_surface(voxelize(in.geometry, VolumeOptions{0.05, 3.0})));
+  ASSERT_TRUE(r.valid());
+  EXPECT_EQ(r.components, 20u);
+  EXPECT_NEAR(r.volume_mm3, placed, 0.01 * placed);
+}
+
 }  // namespace
 }  // namespace lacuna

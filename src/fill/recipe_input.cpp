@@ -6,6 +6,7 @@
 #include <string>
 
 #include "errors.h"
+#include "fill/polyhedra.h"
 #include "fill/wallpaper.h"
 #include "recipe/recipe.h"
 
@@ -269,10 +270,21 @@ void register_recipe_inputs() {
 
   register_input_type(
       {"fill_spheres",
-       {"fit_to", "box", "sphere", "c", "N", "count", "min_radius_mm", "max_trials", "gap_mm", "boundary_gap_mm", "seed"},
+       {"fit_to", "box", "sphere", "motif", "random_rotation", "c", "N", "count", "min_radius_mm", "max_trials", "gap_mm",
+        "boundary_gap_mm", "seed"},
        [](const JsonObject& o, RecipeInput& in) {
          auto f = std::make_shared<FillOptions3>();
          parse_law(o, *f);
+         // Spheres, or convex polyhedra (unit volume, scaled by the rule).
+         const std::string motif_name = o.string_or("motif", "sphere");
+         std::shared_ptr<Motif3> polyhedron;
+         if (motif_name == "cube") polyhedron = std::make_shared<Motif3>(cube_motif());
+         else if (motif_name == "tetrahedron") polyhedron = std::make_shared<Motif3>(tetrahedron_motif());
+         else if (motif_name == "octahedron") polyhedron = std::make_shared<Motif3>(octahedron_motif());
+         else if (motif_name != "sphere")
+           o.fail("motif", "expected \"sphere\", \"cube\", \"tetrahedron\" or \"octahedron\", got \"" + motif_name + "\"");
+         const bool rotate = o.boolean_or("random_rotation", false);
+         if (rotate && !polyhedron) o.fail("random_rotation", "a sphere has no orientation to randomize");
          if (o.has("min_radius_mm")) {
            const double r = o.positive_length("min_radius_mm");
            f->min_volume_mm3 = 4.0 / 3.0 * kPi * r * r * r;
@@ -280,7 +292,23 @@ void register_recipe_inputs() {
          const int given = int(o.has("fit_to")) + int(o.has("box")) + int(o.has("sphere"));
          if (given != 1) o.fail("", "give one region: \"fit_to\" (a closed input), \"box\" or \"sphere\"");
          const std::string where = o.file() + ": " + o.path();
-         auto place = [f, where](RecipeInput& self, const SignedDistance3& sd, const Box3& box, double volume) {
+         auto place = [f, where, polyhedron, rotate](RecipeInput& self, const SignedDistance3& sd, const Box3& box, double volume) {
+           if (polyhedron) {
+             try {
+               FillResult3P r = fill_polyhedra(sd, box, volume, *polyhedron, *f, rotate);
+               self.report = {{"polyhedra", r.motifs.size()}, {"fill_fraction", r.fill_fraction}, {"stop_reason", r.stop_reason}};
+               ConvexCells cells;
+               cells.corners_per_cell = int(polyhedron->vertices.size());
+               cells.faces = polyhedron->faces;
+               for (const Placement3& p : r.motifs)
+                 for (const Vec3d& v : placed_vertices(*polyhedron, p)) cells.corners_mm.push_back(v);
+               if (cells.corners_mm.empty()) throw InvalidInput("no polyhedron could be placed");
+               self.geometry.cells.push_back(std::move(cells));
+             } catch (const InvalidInput& e) {
+               throw InvalidInput(where + ": " + e.what());
+             }
+             return;
+           }
            try {
              FillResult3 r = fill_spheres(sd, box, volume, *f);
              self.report = {{"spheres", r.centers_mm.size()}, {"fill_fraction", r.fill_fraction}, {"stop_reason", r.stop_reason}};
@@ -315,11 +343,13 @@ void register_recipe_inputs() {
          }
          const std::string hull = o.string("fit_to");
          in.depends_on.push_back(hull);
-         in.resolve = [f, hull, place](RecipeInput& self, const RecipeContext& context) {
+         in.resolve = [f, hull, place, polyhedron](RecipeInput& self, const RecipeContext& context) {
            const Box3 box = context.box_of(hull);
            const double volume = context.volume_of(hull);
            // The field must be exact as deep as the largest sphere's radius plus its wall.
-           const double r0 = std::cbrt(3 * volume / (4 * kPi * hurwitz_zeta(f->c, f->N) * std::pow(f->N, f->c)));
+           const double v0 = volume / (hurwitz_zeta(f->c, f->N) * std::pow(f->N, f->c));
+           // The largest motif's reach from its centre: a sphere's radius, a polyhedron's bounding radius.
+           const double r0 = polyhedron ? std::cbrt(v0) * polyhedron->bounding_radius : std::cbrt(3 * v0 / (4 * kPi));
            place(self, context.signed_distance_in(hull, r0 + f->boundary_gap_mm + f->gap_mm + 1e-3, 1e-3 + 0.01 * r0), box,
                  volume);
          };
