@@ -682,3 +682,36 @@ TEST(Fill, Spheres) {
 
 }  // namespace
 }  // namespace lacuna
+
+namespace lacuna {
+namespace {
+
+TEST(Fill, WallpaperSnapEveryGroup) {
+  // Circles have every symmetry, so under snap any motif meeting a mirror or a rotation centre is
+  // moved onto it. In every group the result is invariant, no two motifs (images included)
+  // overlap, and the areas follow the law with the stabilizer factor.
+  fill::FillOptions o;
+  o.max_count = 25;
+  o.N = 1.5;
+  o.gap_mm = 0.01;
+  int snapped_groups = 0;
+  for (int gi = 0; gi < 17; ++gi) {
+    const fill::Group g = fill::Group(gi);
+    SCOPED_TRACE(fill::group_name(g));
+    const fill::WallpaperFill snap = fill::fill_wallpaper(g, valid_lattice(g), fill::circle_motif(), o, fill::BoundaryPolicy::kSnap);
+    ASSERT_GT(snap.fundamental.motifs.size(), 5u) << snap.fundamental.stop_reason;
+    expect_area_law(snap.fundamental, law_check(snap), o.c, o.N, 1);
+    expect_invariant(snap);
+    expect_separated(snap.motif, fill::replicate(snap, 3, 3), o.gap_mm);
+    int snapped = 0;
+    for (const Placement2& p : snap.fundamental.motifs) snapped += p.stabilizer_order > 1;
+    snapped_groups += snapped > 0;
+    if (g == fill::Group::p1) {
+      EXPECT_EQ(snapped, 0);  // p1 has nothing to snap onto
+    }
+  }
+  EXPECT_GE(snapped_groups, 8);  // most groups met a mirror or a centre in 25 motifs
+}
+
+}  // namespace
+}  // namespace lacuna
