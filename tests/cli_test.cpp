@@ -517,6 +517,46 @@ TEST(Cli, FillPatternJsonSvgAndDeterminism) {
   EXPECT_NE(bad_lattice.err.find("p4"), std::string::npos) << bad_lattice.err;
 }
 
+TEST(Cli, VoronoiRulesAndCells) {
+  TempDir dir;
+  const std::string points = quote("0.86,0.3;0.3,0.65;0.73,0.85");
+  Result rules = lacuna("voronoi rules --dim 2 --d 2 --points " + points + " --json", dir.path());
+  ASSERT_EQ(rules.code, 0) << rules.err;
+  nlohmann::json r = nlohmann::json::parse(rules.out);
+  ASSERT_EQ(r["rules"].size(), 3u);
+  size_t children = 0;
+  for (const auto& list : r["rules"]) children += list.size();
+  EXPECT_EQ(children, 4u * 3u);  // d^n m
+  std::vector<int> follows;
+  for (const auto& c : r["rules"][0]) follows.push_back(c["rule"].get<int>());
+  std::sort(follows.begin(), follows.end());
+  EXPECT_EQ(follows, (std::vector<int>{1, 2, 2, 3}));
+  double sum = 0;
+  for (const auto& a : r["limit_measures"]) sum += a.get<double>();
+  EXPECT_NEAR(sum, 1, 1e-12);
+  // Measured colour areas: they partition the torus, and approach the limit as the level grows.
+  auto error_at = [&](int level) {
+    Result cells = lacuna("voronoi cells --points " + points + " --level " + std::to_string(level) + " --json", dir.path());
+    EXPECT_EQ(cells.code, 0) << cells.err;
+    nlohmann::json c = nlohmann::json::parse(cells.out);
+    double total = 0, error = 0;
+    for (size_t i = 0; i < 3; ++i) {
+      total += c["measures"][i].get<double>();
+      error = std::max(error, std::abs(c["measures"][i].get<double>() - r["limit_measures"][i].get<double>()));
+    }
+    EXPECT_NEAR(total, 1, 1e-9);
+    EXPECT_EQ(c["points"], 3 * (1 << (2 * level)));
+    return error;
+  };
+  EXPECT_LT(error_at(4), error_at(1));
+  Result one = lacuna("voronoi cells --points 0.2,0.7 --level 2 --json", dir.path());
+  ASSERT_EQ(one.code, 0) << one.err;
+  EXPECT_NEAR(nlohmann::json::parse(one.out)["measures"][0].get<double>(), 1, 1e-12);
+  Result bad = lacuna("voronoi rules --points " + quote("0.2,0.7;1.3,0.1"), dir.path());
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("point"), std::string::npos) << bad.err;
+}
+
 TEST(Cli, MalformedInputIsRejectedWithExitTwoAndNothingWritten) {
   std::vector<BadCase> cases = bad_cases();
   ASSERT_GE(cases.size(), 30u);

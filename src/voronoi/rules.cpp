@@ -1,0 +1,569 @@
+#include "voronoi/rules.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <set>
+#include <stdexcept>
+#include <string>
+
+#include "errors.h"
+
+namespace lacuna {
+namespace voronoi {
+namespace {
+
+constexpr double kMaxRuleChildren = 1e6;
+constexpr int kMaxStartingPoints = 1000;
+constexpr double kMaxLevelPoints = 2e7;
+// Generators closer than this (torus units) are one site: rounding separates copies that the recursion
+// places at the same point by different paths.
+constexpr double kCoincident = 1e-12;
+
+uint64_t splitmix64(uint64_t& x) {
+  uint64_t z = (x += 0x9E3779B97F4A7C15ull);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+uint64_t rotl(uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
+
+// xoshiro256**, as fill::Random (not shared: voronoi does not depend on fill).
+class Random {
+ public:
+  explicit Random(uint64_t seed) {
+    uint64_t x = seed;
+    for (uint64_t& s : state_) s = splitmix64(x);
+  }
+  uint64_t next() {
+    const uint64_t result = rotl(state_[1] * 5, 7) * 9;
+    const uint64_t t = state_[1] << 17;
+    state_[2] ^= state_[0];
+    state_[3] ^= state_[1];
+    state_[1] ^= state_[2];
+    state_[0] ^= state_[3];
+    state_[2] ^= t;
+    state_[3] = rotl(state_[3], 45);
+    return result;
+  }
+  double uniform() { return double(next() >> 11) * 0x1.0p-53; }
+
+ private:
+  uint64_t state_[4];
+};
+
+double wrap(double x) {
+  double w = x - std::floor(x);
+  // x slightly below an integer rounds up to exactly 1.
+  return w >= 1 ? 0.0 : w;
+}
+
+int nearest_point(const std::vector<std::vector<double>>& points, const std::vector<double>& q) {
+  int best = 0;
+  double best_d2 = torus_distance_squared(points[0], q);
+  for (size_t i = 1; i < points.size(); ++i) {
+    const double d2 = torus_distance_squared(points[i], q);
+    if (d2 < best_d2) {  // strict: a tie keeps the lower colour
+      best_d2 = d2;
+      best = int(i);
+    }
+  }
+  return best;
+}
+
+// The limit of Q^s u for the lazy column-stochastic Q = (I + M / d^n) / 2 and u uniform: the eigenvector of
+// M for d^n (the lazy chain is aperiodic, so this converges even when M is periodic). Q is squared until it
+// stops changing.
+std::vector<double> perron_vector(const Eigen::MatrixXd& matrix, double dn) {
+  const Eigen::Index m = matrix.rows();
+  Eigen::MatrixXd q = 0.5 * (Eigen::MatrixXd::Identity(m, m) + matrix / dn);
+  for (int s = 0; s < 64; ++s) {
+    Eigen::MatrixXd q2 = q * q;
+    const double change = (q2 - q).cwiseAbs().maxCoeff();
+    q.swap(q2);
+    if (change <= 1e-16) break;
+  }
+  Eigen::VectorXd a = q * Eigen::VectorXd::Constant(m, 1.0 / double(m));
+  a = a.cwiseMax(0.0);
+  a /= a.sum();
+  // A few plain steps remove the rounding left by the squarings (M a / d^n keeps the sum: columns sum to d^n).
+  for (int s = 0; s < 4; ++s) a = 0.5 * (a + matrix * a / dn);
+  const double residual = (matrix * a - dn * a).cwiseAbs().maxCoeff();
+  if (!(residual <= 1e-9 * dn))
+    throw std::logic_error("voronoi: the limit measures are not an eigenvector of M for d^n (residual " +
+                           std::to_string(residual) + ")");
+  return std::vector<double>(a.data(), a.data() + m);
+}
+
+// ---- periodic Voronoi cells by clipping ----
+
+// A uniform grid of g^n buckets over the torus.
+struct Grid {
+  int n = 2;
+  int g = 1;
+  std::vector<int> start;  // bucket b holds order[start[b] .. start[b + 1])
+  std::vector<int> order;
+
+  int cell_of(double x) const { return std::min(g - 1, int(x * g)); }
+};
+
+Grid make_grid(const Level& level) {
+  Grid grid;
+  grid.n = level.dimension;
+  const double count = double(level.points.size());
+  grid.g = std::max(1, int(std::ceil(std::pow(count / 2, 1.0 / grid.n))));
+  size_t buckets = 1;
+  for (int j = 0; j < grid.n; ++j) buckets *= size_t(grid.g);
+  std::vector<int> bucket(level.points.size());
+  grid.start.assign(buckets + 1, 0);
+  for (size_t i = 0; i < level.points.size(); ++i) {
+    int b = 0;
+    for (int j = grid.n - 1; j >= 0; --j) b = b * grid.g + grid.cell_of(level.points[i][size_t(j)]);
+    bucket[i] = b;
+    ++grid.start[size_t(b) + 1];
+  }
+  for (size_t b = 0; b < buckets; ++b) grid.start[b + 1] += grid.start[b];
+  grid.order.resize(level.points.size());
+  std::vector<int> fill(grid.start.begin(), grid.start.end() - 1);
+  for (size_t i = 0; i < level.points.size(); ++i) grid.order[size_t(fill[size_t(bucket[i])]++)] = int(i);
+  return grid;
+}
+
+int floor_div(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
+
+// Calls visit(t, shift) for every generator t in the unwrapped grid cells at Chebyshev distance exactly
+// `ring` from `home` (shift: the whole periods added to t's wrapped position).
+template <class Visit>
+void visit_ring(const Grid& grid, const std::array<int, 3>& home, int ring, Visit&& visit) {
+  const int n = grid.n;
+  std::array<int, 3> offset{-ring, -ring, n == 3 ? -ring : 0};
+  for (;;) {
+    int chebyshev = 0;
+    for (int j = 0; j < n; ++j) chebyshev = std::max(chebyshev, std::abs(offset[size_t(j)]));
+    if (chebyshev == ring) {
+      std::array<double, 3> shift{0, 0, 0};
+      int b = 0;
+      for (int j = n - 1; j >= 0; --j) {
+        const int u = home[size_t(j)] + offset[size_t(j)];
+        const int period = floor_div(u, grid.g);
+        shift[size_t(j)] = period;
+        b = b * grid.g + (u - period * grid.g);
+      }
+      for (int s = grid.start[size_t(b)]; s < grid.start[size_t(b) + 1]; ++s) visit(grid.order[size_t(s)], shift);
+    }
+    int j = 0;
+    while (j < n && offset[size_t(j)] == ring) offset[size_t(j++)] = -ring;
+    if (j == n) return;
+    ++offset[size_t(j)];
+  }
+}
+
+using V2 = std::array<double, 2>;
+using V3 = std::array<double, 3>;
+
+// A convex polygon; label[i] is the generator whose bisector carries the edge from vertex i to i + 1.
+struct Polygon2 {
+  std::vector<V2> v;
+  std::vector<int> label;
+};
+
+// Vertices within this distance (torus units) of a clipping line or plane count as on it, so that a second
+// cut along (nearly) the same plane, from a generator that rounding left beside another, changes nothing.
+constexpr double kOnPlane = 1e-13;
+
+// Keeps the part where nx * x + ny * y <= c.
+void clip(Polygon2& poly, double nx, double ny, double c, int label) {
+  const size_t count = poly.v.size();
+  if (count == 0) return;
+  const double eps = kOnPlane * std::hypot(nx, ny);
+  std::vector<double> f(count);
+  bool any_out = false;
+  for (size_t i = 0; i < count; ++i) {
+    f[i] = nx * poly.v[i][0] + ny * poly.v[i][1] - c;
+    any_out = any_out || f[i] > eps;
+  }
+  if (!any_out) return;
+  Polygon2 out;
+  for (size_t i = 0; i < count; ++i) {
+    const size_t k = (i + 1) % count;
+    const bool in_a = f[i] <= eps, in_b = f[k] <= eps;
+    if (in_a) {
+      out.v.push_back(poly.v[i]);
+      out.label.push_back(poly.label[i]);
+    }
+    if (in_a != in_b) {
+      const double t = std::clamp(f[i] / (f[i] - f[k]), 0.0, 1.0);
+      const V2 p{poly.v[i][0] + t * (poly.v[k][0] - poly.v[i][0]), poly.v[i][1] + t * (poly.v[k][1] - poly.v[i][1])};
+      out.v.push_back(p);
+      // Leaving: the new edge runs along the clipping line; entering: along the old edge.
+      out.label.push_back(in_a ? label : poly.label[i]);
+    }
+  }
+  if (out.v.size() < 3) out = Polygon2{};
+  poly = std::move(out);
+}
+
+double area(const Polygon2& poly) {
+  double a = 0;
+  for (size_t i = 0, count = poly.v.size(); i < count; ++i) {
+    const V2& p = poly.v[i];
+    const V2& q = poly.v[(i + 1) % count];
+    a += p[0] * q[1] - p[1] * q[0];
+  }
+  return a / 2;
+}
+
+// A convex polyhedron as its faces (vertex cycles of either orientation), each labelled with the generator
+// whose bisector carries it.
+struct Polyhedron {
+  std::vector<std::vector<V3>> faces;
+  std::vector<int> label;
+};
+
+V3 sub3(const V3& a, const V3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+V3 cross3(const V3& a, const V3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+double dot3(const V3& a, const V3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+V3 area_vector(const std::vector<V3>& face) {
+  V3 a{0, 0, 0};
+  for (size_t i = 0, count = face.size(); i < count; ++i) {
+    const V3 c = cross3(face[i], face[(i + 1) % count]);
+    for (int j = 0; j < 3; ++j) a[size_t(j)] += c[size_t(j)] / 2;
+  }
+  return a;
+}
+
+// Keeps the part where dot(normal, x) <= c; the cut is closed by a new face labelled `label`.
+void clip(Polyhedron& poly, const V3& normal, double c, int label) {
+  const double eps = kOnPlane * std::sqrt(dot3(normal, normal));
+  bool any_out = false;
+  for (const auto& face : poly.faces)
+    for (const V3& p : face) any_out = any_out || dot3(normal, p) - c > eps;
+  if (!any_out) return;
+  Polyhedron out;
+  std::vector<V3> cap;
+  for (size_t fi = 0; fi < poly.faces.size(); ++fi) {
+    const auto& face = poly.faces[fi];
+    const size_t count = face.size();
+    std::vector<double> f(count);
+    for (size_t i = 0; i < count; ++i) f[i] = dot3(normal, face[i]) - c;
+    std::vector<V3> kept;
+    for (size_t i = 0; i < count; ++i) {
+      const size_t k = (i + 1) % count;
+      const bool in_a = f[i] <= eps, in_b = f[k] <= eps;
+      if (in_a) {
+        kept.push_back(face[i]);
+        if (f[i] >= -eps) cap.push_back(face[i]);
+      }
+      if (in_a != in_b) {
+        const double t = std::clamp(f[i] / (f[i] - f[k]), 0.0, 1.0);
+        const V3 p{face[i][0] + t * (face[k][0] - face[i][0]), face[i][1] + t * (face[k][1] - face[i][1]),
+                   face[i][2] + t * (face[k][2] - face[i][2])};
+        kept.push_back(p);
+        cap.push_back(p);
+      }
+    }
+    if (kept.size() >= 3) {
+      out.faces.push_back(std::move(kept));
+      out.label.push_back(poly.label[fi]);
+    }
+  }
+  if (cap.size() >= 3) {
+    // The cap is convex and lies in the plane: order its points by angle about their mean.
+    V3 centre{0, 0, 0};
+    for (const V3& p : cap)
+      for (int j = 0; j < 3; ++j) centre[size_t(j)] += p[size_t(j)] / double(cap.size());
+    // The axis least aligned with the normal.
+    const double ax = std::fabs(normal[0]), ay = std::fabs(normal[1]), az = std::fabs(normal[2]);
+    const V3 helper = ax <= ay && ax <= az ? V3{1, 0, 0} : (ay <= az ? V3{0, 1, 0} : V3{0, 0, 1});
+    const V3 e1 = cross3(normal, helper);
+    const V3 e2 = cross3(normal, e1);
+    std::vector<std::pair<double, V3>> sorted;
+    for (const V3& p : cap) {
+      const V3 r = sub3(p, centre);
+      sorted.push_back({std::atan2(dot3(r, e2), dot3(r, e1)), p});
+    }
+    std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    std::vector<V3> face;
+    for (const auto& s : sorted) face.push_back(s.second);
+    out.faces.push_back(std::move(face));
+    out.label.push_back(label);
+  }
+  if (out.faces.size() < 4) out = Polyhedron{};
+  poly = std::move(out);
+}
+
+// Pyramids from a point inside the convex polyhedron.
+double volume(const Polyhedron& poly, const V3& inside) {
+  double v = 0;
+  for (const auto& face : poly.faces) v += std::fabs(dot3(area_vector(face), sub3(face[0], inside))) / 3;
+  return v;
+}
+
+void check_level(const Level& level, int n) {
+  if (level.dimension != n)
+    throw InvalidInput("voronoi: a " + std::to_string(level.dimension) + "D level passed to the " + std::to_string(n) +
+                       "D cell measure");
+  if (level.colours.size() != level.points.size()) throw InvalidInput("voronoi: a level needs one colour per point");
+  for (size_t i = 0; i < level.points.size(); ++i) {
+    if (level.colours[i] < 0 || level.colours[i] >= level.colour_count)
+      throw InvalidInput("voronoi: point " + std::to_string(i) + " has colour " + std::to_string(level.colours[i]) +
+                         " outside [0, " + std::to_string(level.colour_count) + ")");
+    if (level.points[i].size() != size_t(n))
+      throw InvalidInput("voronoi: point " + std::to_string(i) + " does not have " + std::to_string(n) +
+                         " coordinates");
+    for (double x : level.points[i])
+      if (!(x >= 0 && x < 1)) throw InvalidInput("voronoi: point " + std::to_string(i) + " lies outside [0,1)^n");
+  }
+}
+
+struct CellScan {
+  std::vector<double> measures;         // per colour
+  std::set<std::pair<int, int>> graph;  // colour pairs sharing a wall
+};
+
+// Every unprocessed generator copy lies at least ring / g from the generator after rings 0 .. ring (the
+// generator's bucket is at least that far inside the block of scanned buckets), so its bisector lies at
+// least ring / (2 g) away and cannot cut a cell whose farthest vertex is nearer.
+CellScan scan_cells(const Level& level, int n, bool want_graph) {
+  check_level(level, n);
+  const Grid grid = make_grid(level);
+  const double h = 1.0 / grid.g;
+  CellScan scan;
+  scan.measures.assign(size_t(level.colour_count), 0.0);
+  const auto& pts = level.points;
+  for (size_t self = 0; self < pts.size(); ++self) {
+    const auto& x = pts[self];
+    std::array<int, 3> home{0, 0, 0};
+    for (int j = 0; j < n; ++j) home[size_t(j)] = grid.cell_of(x[size_t(j)]);
+    std::vector<int> coincident;  // other generators at the same place (the construction makes them for d = 2)
+    Polygon2 poly2;
+    Polyhedron poly3;
+    if (n == 2) {
+      poly2.v = {
+          {x[0] - 0.5, x[1] - 0.5}, {x[0] + 0.5, x[1] - 0.5}, {x[0] + 0.5, x[1] + 0.5}, {x[0] - 0.5, x[1] + 0.5}};
+      poly2.label.assign(4, int(self));
+    } else {
+      const double x0 = x[0] - 0.5, x1 = x[0] + 0.5, y0 = x[1] - 0.5, y1 = x[1] + 0.5, z0 = x[2] - 0.5, z1 = x[2] + 0.5;
+      poly3.faces = {{{x0, y0, z0}, {x0, y1, z0}, {x0, y1, z1}, {x0, y0, z1}},
+                     {{x1, y0, z0}, {x1, y1, z0}, {x1, y1, z1}, {x1, y0, z1}},
+                     {{x0, y0, z0}, {x1, y0, z0}, {x1, y0, z1}, {x0, y0, z1}},
+                     {{x0, y1, z0}, {x1, y1, z0}, {x1, y1, z1}, {x0, y1, z1}},
+                     {{x0, y0, z0}, {x1, y0, z0}, {x1, y1, z0}, {x0, y1, z0}},
+                     {{x0, y0, z1}, {x1, y0, z1}, {x1, y1, z1}, {x0, y1, z1}}};
+      poly3.label.assign(6, int(self));
+    }
+    for (int ring = 0;; ++ring) {
+      visit_ring(grid, home, ring, [&](int t, const std::array<double, 3>& shift) {
+        if (size_t(t) == self) return;
+        std::array<double, 3> y{0, 0, 0}, normal{0, 0, 0};
+        double c = 0;
+        double length2 = 0;
+        for (int j = 0; j < n; ++j) {
+          y[size_t(j)] = pts[size_t(t)][size_t(j)] + shift[size_t(j)];
+          normal[size_t(j)] = y[size_t(j)] - x[size_t(j)];
+          c += normal[size_t(j)] * (y[size_t(j)] + x[size_t(j)]) / 2;
+          length2 += normal[size_t(j)] * normal[size_t(j)];
+        }
+        if (length2 <= kCoincident * kCoincident) {
+          if (std::find(coincident.begin(), coincident.end(), t) == coincident.end()) coincident.push_back(t);
+          return;
+        }
+        if (n == 2)
+          clip(poly2, normal[0], normal[1], c, t);
+        else
+          clip(poly3, normal, c, t);
+      });
+      double r2 = 0;
+      if (n == 2) {
+        for (const V2& p : poly2.v) r2 = std::max(r2, (p[0] - x[0]) * (p[0] - x[0]) + (p[1] - x[1]) * (p[1] - x[1]));
+      } else {
+        const V3 xs{x[0], x[1], x[2]};
+        for (const auto& face : poly3.faces)
+          for (const V3& p : face) r2 = std::max(r2, dot3(sub3(p, xs), sub3(p, xs)));
+      }
+      // The 1e-12 margin covers a generator that rounding placed in a neighbouring bucket.
+      if (2 * std::sqrt(r2) + 1e-12 <= ring * h) break;
+    }
+    const int colour = level.colours[self];
+    const double share = 1.0 / double(coincident.size() + 1);
+    for (int t : coincident) {
+      const int other = level.colours[size_t(t)];
+      if (want_graph && other != colour) scan.graph.insert({std::min(colour, other), std::max(colour, other)});
+    }
+    if (n == 2) {
+      scan.measures[size_t(colour)] += share * area(poly2);
+      if (want_graph)
+        for (size_t i = 0; i < poly2.v.size(); ++i) {
+          const int other = level.colours[size_t(poly2.label[i])];
+          const V2& p = poly2.v[i];
+          const V2& q = poly2.v[(i + 1) % poly2.v.size()];
+          if (other != colour && std::hypot(q[0] - p[0], q[1] - p[1]) > 1e-12)
+            scan.graph.insert({std::min(colour, other), std::max(colour, other)});
+        }
+    } else {
+      scan.measures[size_t(colour)] += share * volume(poly3, {x[0], x[1], x[2]});
+      if (want_graph)
+        for (size_t i = 0; i < poly3.faces.size(); ++i) {
+          const int other = level.colours[size_t(poly3.label[i])];
+          const V3 a = area_vector(poly3.faces[i]);
+          if (other != colour && std::sqrt(dot3(a, a)) > 1e-12)
+            scan.graph.insert({std::min(colour, other), std::max(colour, other)});
+        }
+    }
+  }
+  return scan;
+}
+
+Level level_zero(const Rules& rules) {
+  Level level;
+  level.dimension = rules.dimension;
+  level.colour_count = int(rules.points.size());
+  level.points = rules.points;
+  for (size_t i = 0; i < rules.points.size(); ++i) level.colours.push_back(int(i));
+  return level;
+}
+
+void sub(const Rules& rules, int i, int k, int s, int c, const std::vector<double>& p, const std::vector<double>& scale,
+         Level& level) {
+  if (i < k) {
+    std::vector<double> child(p.size());
+    for (const Rule& rule : rules.rules[size_t(c)]) {
+      for (size_t j = 0; j < p.size(); ++j) child[j] = p[j] + rule.offset[j] * scale[size_t(i)];
+      sub(rules, i + 1, k, s, rule.follows, child, scale, level);
+    }
+    return;
+  }
+  std::vector<double> q(p.size());
+  for (size_t j = 0; j < p.size(); ++j) q[j] = wrap(p[j]);
+  level.points.push_back(std::move(q));
+  level.colours.push_back(s);
+}
+
+}  // namespace
+
+double torus_distance_squared(const std::vector<double>& p, const std::vector<double>& q) {
+  double sum = 0;
+  for (size_t j = 0; j < p.size(); ++j) {
+    const double a = std::fabs(p[j] - q[j]);
+    const double t = std::min(a, 1 - a);
+    sum += t * t;
+  }
+  return sum;
+}
+
+Rules make_rules(int n, int d, const std::vector<std::vector<double>>& points, const RulesOptions& options) {
+  if (n != 2 && n != 3) throw InvalidInput("voronoi: the dimension must be 2 or 3, got " + std::to_string(n));
+  if (d < 2) throw InvalidInput("voronoi: the lacunarity d must be at least 2, got " + std::to_string(d));
+  const size_t m = points.size();
+  if (m == 0) throw InvalidInput("voronoi: at least one starting point is needed");
+  const double dn_real = std::pow(double(d), n);
+  if (dn_real * double(m) > kMaxRuleChildren)
+    throw ResourceLimit("voronoi: d^n m = " + std::to_string(dn_real * double(m)) + " rule children exceed the " +
+                        "limit of 1e6; use fewer points or a smaller d");
+  if (m > size_t(kMaxStartingPoints))
+    throw ResourceLimit("voronoi: " + std::to_string(m) + " starting points exceed the limit of " +
+                        std::to_string(kMaxStartingPoints) + " (the rule matrix is dense)");
+  for (size_t i = 0; i < m; ++i) {
+    if (points[i].size() != size_t(n))
+      throw InvalidInput("voronoi: starting point " + std::to_string(i) + " has " + std::to_string(points[i].size()) +
+                         " coordinates, expected " + std::to_string(n));
+    for (int j = 0; j < n; ++j) {
+      const double x = points[i][size_t(j)];
+      if (!(x >= 0 && x < 1))
+        throw InvalidInput("voronoi: coordinate " + std::to_string(j) + " of starting point " + std::to_string(i) +
+                           " is " + std::to_string(x) + ", outside [0, 1)");
+    }
+  }
+  for (size_t i = 0; i < m; ++i)
+    for (size_t k = i + 1; k < m; ++k)
+      if (torus_distance_squared(points[i], points[k]) == 0)
+        throw InvalidInput("voronoi: starting point " + std::to_string(k) + " coincides with starting point " +
+                           std::to_string(i));
+
+  Rules rules;
+  rules.dimension = n;
+  rules.d = d;
+  rules.points = points;
+  rules.rules.assign(m, {});
+  rules.matrix = Eigen::MatrixXd::Zero(Eigen::Index(m), Eigen::Index(m));
+  const int dn = int(dn_real);
+  std::vector<double> q(static_cast<size_t>(n));
+  for (size_t i = 0; i < m; ++i)
+    for (int t = 0; t < dn; ++t) {
+      int digits = t;
+      for (int j = 0; j < n; ++j) {
+        const int a = digits % d;
+        digits /= d;
+        if (options.children == RulesOptions::Children::kScaled) {
+          q[size_t(j)] = wrap((points[i][size_t(j)] + double(a)) / d);  // rounding can reach 1
+        } else {
+          double x = points[i][size_t(j)] + double(a) / d;
+          if (x >= 1) x -= 1;  // exact (Sterbenz): x is in [1, 2)
+          q[size_t(j)] = x;
+        }
+      }
+      const int r = nearest_point(points, q);
+      Rule rule;
+      rule.follows = int(i);
+      rule.offset.resize(size_t(n));
+      for (int j = 0; j < n; ++j) {
+        const double qj = q[size_t(j)], rj = points[size_t(r)][size_t(j)];
+        rule.offset[size_t(j)] = qj - rj + std::floor(rj - qj + 0.5);
+      }
+      rules.rules[size_t(r)].push_back(std::move(rule));
+      rules.matrix(Eigen::Index(r), Eigen::Index(i)) += 1;
+    }
+  rules.limit_measures = perron_vector(rules.matrix, dn_real);
+
+  const Level zero = level_zero(rules);
+  const Level one = generate_level(rules, 1);
+  rules.graph_connected_condition = colour_graph(zero) == colour_graph(one);
+  return rules;
+}
+
+std::vector<std::vector<double>> random_points(int n, int m, uint64_t seed) {
+  if (n < 1 || m < 0)
+    throw InvalidInput("voronoi: random_points needs n >= 1 and m >= 0, got n = " + std::to_string(n) +
+                       ", m = " + std::to_string(m));
+  Random random(seed);
+  std::vector<std::vector<double>> points(static_cast<size_t>(m), std::vector<double>(static_cast<size_t>(n)));
+  for (auto& p : points)
+    for (double& x : p) x = random.uniform();
+  return points;
+}
+
+Level generate_level(const Rules& rules, int k) {
+  if (k < 0) throw InvalidInput("voronoi: the level must be >= 0, got " + std::to_string(k));
+  const double dn = std::pow(double(rules.d), rules.dimension);
+  const double count = std::pow(dn, k) * double(rules.points.size());
+  if (count > kMaxLevelPoints)
+    throw ResourceLimit("voronoi: level " + std::to_string(k) + " would hold " + std::to_string(count) +
+                        " points, more than the limit of 20000000; use a lower level");
+  std::vector<double> scale(size_t(k) + 1, 1.0);
+  for (int i = 1; i <= k; ++i) scale[size_t(i)] = scale[size_t(i) - 1] / rules.d;  // powers of d: exact enough
+  Level level = level_zero(rules);
+  level.points.clear();
+  level.colours.clear();
+  level.points.reserve(size_t(count));
+  level.colours.reserve(size_t(count));
+  for (size_t c = 0; c < rules.points.size(); ++c) sub(rules, 0, k, int(c), int(c), rules.points[c], scale, level);
+  return level;
+}
+
+std::vector<double> cell_measures_2d(const Level& level) { return scan_cells(level, 2, false).measures; }
+
+std::vector<double> cell_measures_3d(const Level& level) { return scan_cells(level, 3, false).measures; }
+
+std::vector<std::pair<int, int>> colour_graph(const Level& level) {
+  if (level.dimension != 2 && level.dimension != 3)
+    throw InvalidInput("voronoi: a level must be 2D or 3D, got " + std::to_string(level.dimension));
+  const CellScan scan = scan_cells(level, level.dimension, true);
+  return {scan.graph.begin(), scan.graph.end()};
+}
+
+}  // namespace voronoi
+}  // namespace lacuna
