@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "errors.h"
+#include "recipe/recipe.h"
 #include "voronoi/rules.h"
 
 namespace lacuna {
@@ -354,6 +355,41 @@ TEST(VoronoiRandom, Deterministic) {
   // The first value of xoshiro256** seeded through splitmix64 from 0, top 53 bits, from an independent
   // Python transcription of the reference algorithms.
   EXPECT_EQ(voronoi::random_points(1, 1, 0)[0][0], 0x1.33d8be6d96ebep-1);
+}
+
+}  // namespace
+}  // namespace lacuna
+
+namespace lacuna {
+namespace {
+
+TEST(VoronoiSpheres, RecipeInputPlacesOneSpherePerKeptGenerator) {
+  // Level 2 of 3 starting points in 2D, d = 2: 48 generators; the spheres are those of colour 2
+  // (counted from the level itself), tiled over 2 x 1 periods of 10 mm from the origin.
+  const std::string text = R"({
+    "inputs": {
+      "g": {"type": "voronoi_spheres", "dimension": 2, "points": [[0.86, 0.3], [0.3, 0.65], [0.73, 0.85]],
+            "level": 2, "period_mm": 10, "radius_mm": 0.5, "colours": [2], "tiles": [2, 1], "origin_mm": [1, 2, 3]}
+    },
+    "outputs": [{"of": "g", "file": "g.stl"}]
+  })";
+  Recipe recipe = parse_recipe(text, "spheres.json");
+  const RecipeInput& in = recipe.inputs[0];
+  voronoi::RulesOptions options;
+  options.children = voronoi::RulesOptions::Children::kScaled;
+  const voronoi::Level level =
+      voronoi::generate_level(voronoi::make_rules(2, 2, {{0.86, 0.3}, {0.3, 0.65}, {0.73, 0.85}}, options), 2);
+  size_t colour2 = 0;
+  for (int c : level.colours) colour2 += c == 1;
+  EXPECT_EQ(in.report["points"], 48);
+  ASSERT_EQ(in.geometry.spheres.centers_mm.size(), 2 * colour2);
+  for (const Vec3d& p : in.geometry.spheres.centers_mm) {
+    EXPECT_GE(p.x, 1);
+    EXPECT_LT(p.x, 21);
+    EXPECT_GE(p.y, 2);
+    EXPECT_LT(p.y, 12);
+    EXPECT_EQ(p.z, 3);
+  }
 }
 
 }  // namespace
