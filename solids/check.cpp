@@ -14,6 +14,7 @@
 #include <unordered_map>
 
 #include "solids/components.h"
+#include "solids/disjoint_sets.h"
 #include "util/progress.h"
 
 namespace lacuna {
@@ -27,26 +28,6 @@ struct HalfEdge {
   uint64_t key;  // (min vertex << 32) | max vertex
   uint32_t id;   // 3 * face + corner; the half-edge runs from corner to corner + 1
   bool operator<(const HalfEdge& o) const { return key != o.key ? key < o.key : id < o.id; }
-};
-
-class DisjointSets {
- public:
-  explicit DisjointSets(size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0u); }
-  uint32_t find(uint32_t v) {
-    while (parent_[v] != v) {
-      parent_[v] = parent_[parent_[v]];
-      v = parent_[v];
-    }
-    return v;
-  }
-  void join(uint32_t a, uint32_t b) {
-    a = find(a);
-    b = find(b);
-    if (a != b) parent_[std::max(a, b)] = std::min(a, b);
-  }
-
- private:
-  std::vector<uint32_t> parent_;
 };
 
 // Orientation of (a, b, p) in the (y, z) projection, exact, with p moved by the infinitesimal

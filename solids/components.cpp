@@ -1,31 +1,21 @@
 #include "solids/components.h"
 
-#include <numeric>
+#include "solids/disjoint_sets.h"
 
 namespace lacuna {
 
 std::vector<MeshComponent> mesh_components(const TriMesh& m) {
-  std::vector<uint32_t> parent(m.positions_mm.size());
-  std::iota(parent.begin(), parent.end(), 0u);
-  auto find = [&](uint32_t v) {
-    while (parent[v] != v) v = parent[v] = parent[parent[v]];
-    return v;
-  };
-  auto join = [&](uint32_t a, uint32_t b) {
-    a = find(a);
-    b = find(b);
-    if (a != b) parent[std::max(a, b)] = std::min(a, b);
-  };
+  DisjointSets sets(m.positions_mm.size());
   for (const auto& t : m.triangles) {
-    join(t[0], t[1]);
-    join(t[1], t[2]);
+    sets.join(t[0], t[1]);
+    sets.join(t[1], t[2]);
   }
   std::vector<int> index(m.positions_mm.size(), -1);
   std::vector<MeshComponent> out;
   std::vector<Vec3d> moment;  // sum of det * (a + b + c), for the volume centroid
   for (uint32_t f = 0; f < m.triangles.size(); ++f) {
     const auto& t = m.triangles[f];
-    uint32_t root = find(t[0]);
+    uint32_t root = sets.find(t[0]);
     if (index[root] < 0) {
       index[root] = int(out.size());
       out.emplace_back();

@@ -22,6 +22,7 @@
 #include <utility>
 
 #include "errors.h"
+#include "solids/disjoint_sets.h"
 
 namespace lacuna {
 namespace {
@@ -65,26 +66,6 @@ using MeanValueParameterizer = smp::Mean_value_coordinates_parameterizer_3<Surfa
 
 constexpr uint32_t kNone = std::numeric_limits<uint32_t>::max();
 constexpr double kPi = 3.14159265358979323846;
-
-class DisjointSets {
- public:
-  explicit DisjointSets(size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0u); }
-  uint32_t find(uint32_t v) {
-    while (parent_[v] != v) {
-      parent_[v] = parent_[parent_[v]];
-      v = parent_[v];
-    }
-    return v;
-  }
-  void join(uint32_t a, uint32_t b) {
-    a = find(a);
-    b = find(b);
-    if (a != b) parent_[std::max(a, b)] = std::min(a, b);
-  }
-
- private:
-  std::vector<uint32_t> parent_;
-};
 
 std::string describe(const Vec3d& p) {
   std::ostringstream s;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "geometry.h"
+#include "util/random.h"
 
 namespace lacuna {
 namespace fill {
@@ -18,15 +19,8 @@ namespace fill {
 // unless s > 1 and q > 0 (both finite).
 double hurwitz_zeta(double s, double q);
 
-// The project's own generator, identical on every platform: xoshiro256** seeded through splitmix64.
-class Random {
- public:
-  explicit Random(uint64_t seed);
-  uint64_t next();   // 64 random bits
-  double uniform();  // in [0, 1), from the top 53 bits
- private:
-  uint64_t state_[4];
-};
+// The project's own generator (util/random.h).
+using ::lacuna::Random;
 
 // A motif in its own frame: centroid at the origin, area 1.
 struct Motif2 {
