@@ -316,6 +316,11 @@ bool overlap(const Shape2& a, const Shape2& b, double gap) {
   return gap > 0 && vertex_outline_distance(a.points, b.points) < gap;
 }
 
+std::string trials_reason(const char* what, size_t i, size_t trials) {
+  return "max_trials: " + std::string(what) + " " + std::to_string(i) + " could not be placed in " +
+         std::to_string(trials) + " trials";
+}
+
 }  // namespace detail
 
 double hurwitz_zeta(double s, double q) {
@@ -478,11 +483,6 @@ void region_box(const FillRegion2& region, Vec2d& lo, Vec2d& hi) {
   }
 }
 
-std::string trials_reason(const char* what, size_t i, size_t trials) {
-  return "max_trials: " + std::string(what) + " " + std::to_string(i) + " could not be placed in " +
-         std::to_string(trials) + " trials";
-}
-
 }  // namespace
 
 bool contains(const FillRegion2& region, const Motif2& motif, const Placement2& placement, double clearance_mm) {
@@ -526,7 +526,7 @@ FillResult2 fill_region(const FillRegion2& region, const Motif2& motif, const Fi
       placed = true;
     }
     if (!placed) {
-      result.stop_reason = trials_reason("motif", i, options.max_trials);
+      result.stop_reason = detail::trials_reason("motif", i, options.max_trials);
       return result;
     }
     result.motifs.push_back(pl);
@@ -574,7 +574,7 @@ FillResult3 fill_spheres(const SignedDistance3& signed_distance_mm, const Box3& 
       placed = true;
     }
     if (!placed) {
-      result.stop_reason = trials_reason("sphere", i, options.max_trials);
+      result.stop_reason = detail::trials_reason("sphere", i, options.max_trials);
       return result;
     }
     result.fill_fraction += fraction;

@@ -286,8 +286,7 @@ FillResult3P fill_polyhedra(const SignedDistance3& signed_distance_mm, const Box
       placed = true;
     }
     if (!placed) {
-      result.stop_reason = "max_trials: motif " + std::to_string(i) + " could not be placed in " +
-                           std::to_string(options.max_trials) + " trials";
+      result.stop_reason = detail::trials_reason("motif", i, options.max_trials);
       return result;
     }
     result.motifs.push_back(pl);

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <map>
 #include <unordered_map>
+#include <string>
 #include <vector>
 
 #include "fill/fill.h"
@@ -50,6 +51,9 @@ double vertex_outline_distance(const std::vector<Vec2d>& a, const std::vector<Ve
 // Whether the shapes come closer than gap_mm (overlapping shapes are at distance 0); with gap 0, touching
 // shapes do not overlap, except that non-convex polygons whose outlines touch count as overlapping.
 bool overlap(const Shape2& a, const Shape2& b, double gap_mm);
+
+// The stop reason of a fill whose motif i found no room: "max_trials: <what> i could not be placed in T trials".
+std::string trials_reason(const char* what, size_t i, size_t trials);
 
 // A hierarchical uniform grid: an entry of radius r lives in the level whose cell size h = 2^L is the
 // smallest power of two >= r, in the one cell holding its centre; a query visits, on each level, the cells

@@ -447,8 +447,7 @@ WallpaperFill fill_wallpaper(Group group, const Lattice& lattice, const Motif2& 
       placed = true;
     }
     if (!placed) {
-      result.stop_reason = "max_trials: motif " + std::to_string(i) + " could not be placed in " +
-                           std::to_string(options.max_trials) + " trials";
+      result.stop_reason = detail::trials_reason("motif", i, options.max_trials);
       return out;
     }
     result.fill_fraction += fraction;
