@@ -23,6 +23,8 @@ struct ReadOptions {
   // Refuse files whose declared or implied size would need more memory than this (bytes); the
   // check happens before the large allocation. ResourceLimit is thrown beyond it.
   uint64_t max_memory_bytes = uint64_t{8} << 30;
+  // 3MF: when set, receives the name of each build item's object, in build order.
+  std::vector<std::string>* object_names = nullptr;
 };
 
 // Reads a mesh. STL vertices are welded where their float coordinates are identical (STL stores
@@ -45,5 +47,14 @@ struct ThreeMfInfo {
 // Writes a 3MF package (unit millimetre) with one mesh object and one build item.
 // Byte-identical output for identical input. Throws IoError on failure.
 void write_3mf(const std::string& path, const TriMesh& mesh, const ThreeMfInfo& info);
+
+// One object of a package with several (the mesh is not copied; it must outlive the call).
+struct ThreeMfObject {
+  const TriMesh* mesh = nullptr;
+  std::string name;
+};
+
+// The same with one mesh object and one build item per part, in order (info.object_name unused).
+void write_3mf(const std::string& path, const std::vector<ThreeMfObject>& parts, const ThreeMfInfo& info);
 
 }  // namespace lacuna

@@ -569,6 +569,15 @@ TriMesh read_3mf(const std::string& path, const ReadOptions& options) {
                           path);
       placement = from_lib3mf(t);
     }
+    if (options.object_names) {
+      ULONG needed = 0;
+      check<InvalidInput>(NMR::lib3mf_object_getnameutf8(object->get(), nullptr, 0, &needed), object->get(), path);
+      std::string name(size_t(needed) + 1, '\0');
+      check<InvalidInput>(NMR::lib3mf_object_getnameutf8(object->get(), name.data(), ULONG(name.size()), &needed),
+                          object->get(), path);
+      name.resize(std::strlen(name.c_str()));
+      options.object_names->push_back(name);
+    }
     auto [v, t] = objects.count(object->get(), 0);
     vertices += v;
     triangles += t;
@@ -591,33 +600,46 @@ TriMesh read_3mf(const std::string& path, const ReadOptions& options) {
 }
 
 void write_3mf(const std::string& path, const TriMesh& mesh, const ThreeMfInfo& info) {
+  write_3mf(path, std::vector<ThreeMfObject>{{&mesh, info.object_name}}, info);
+}
+
+void write_3mf(const std::string& path, const std::vector<ThreeMfObject>& parts, const ThreeMfInfo& info) {
   auto invalid = [&](const std::string& what) {
     throw InvalidInput(cat("cannot write '", path, "': ", what));
   };
-  if (mesh.positions_mm.size() > kMaxIndex || mesh.triangles.size() > kMaxIndex) {
-    throw ResourceLimit(
-        cat("cannot write '", path, "': more than ", kMaxIndex, " vertices or triangles"));
-  }
-  std::vector<NMR::MODELMESHVERTEX> vertices(mesh.positions_mm.size());
-  for (size_t i = 0; i < vertices.size(); ++i) {
-    for (int axis = 0; axis < 3; ++axis) {
-      float value = static_cast<float>(mesh.positions_mm[i][axis]);
-      if (!(std::fabs(value) <= kMaxCoordinateMm)) {
-        invalid(cat("vertex ", i, " has coordinate ", mesh.positions_mm[i][axis],
-                    "; 3MF coordinates must be finite and within 1e9 mm"));
-      }
-      vertices[i].m_fPosition[axis] = value;
+  if (parts.empty()) invalid("no objects to write");
+  std::vector<std::vector<NMR::MODELMESHVERTEX>> all_vertices;
+  std::vector<std::vector<NMR::MODELMESHTRIANGLE>> all_triangles;
+  for (const ThreeMfObject& part : parts) {
+    const TriMesh& mesh = *part.mesh;
+    if (mesh.positions_mm.size() > kMaxIndex || mesh.triangles.size() > kMaxIndex) {
+      throw ResourceLimit(
+          cat("cannot write '", path, "': more than ", kMaxIndex, " vertices or triangles"));
     }
-  }
-  std::vector<NMR::MODELMESHTRIANGLE> triangles(mesh.triangles.size());
-  for (size_t t = 0; t < triangles.size(); ++t) {
-    for (int k = 0; k < 3; ++k) {
-      uint32_t v = mesh.triangles[t][k];
-      if (v >= vertices.size()) {
-        invalid(cat("triangle ", t, " refers to vertex ", v, " of ", vertices.size()));
+    std::vector<NMR::MODELMESHVERTEX> vertices(mesh.positions_mm.size());
+    for (size_t i = 0; i < vertices.size(); ++i) {
+      for (int axis = 0; axis < 3; ++axis) {
+        float value = static_cast<float>(mesh.positions_mm[i][axis]);
+        if (!(std::fabs(value) <= kMaxCoordinateMm)) {
+          invalid(cat("vertex ", i, " has coordinate ", mesh.positions_mm[i][axis],
+                      "; 3MF coordinates must be finite and within 1e9 mm"));
+        }
+        vertices[i].m_fPosition[axis] = value;
       }
-      triangles[t].m_nIndices[k] = v;
     }
+    std::vector<NMR::MODELMESHTRIANGLE> triangles(mesh.triangles.size());
+    for (size_t t = 0; t < triangles.size(); ++t) {
+      for (int k = 0; k < 3; ++k) {
+        uint32_t v = mesh.triangles[t][k];
+        if (v >= vertices.size()) {
+          invalid(cat("triangle ", t, " refers to vertex ", v, " of ", vertices.size()));
+        }
+        triangles[t].m_nIndices[k] = v;
+      }
+    }
+    if (has_control_character(part.name)) invalid("an object name contains a control character");
+    all_vertices.push_back(std::move(vertices));
+    all_triangles.push_back(std::move(triangles));
   }
   // The 3MF core specification allows these names without a namespace; lib3mf 1.8 cannot declare
   // namespaces for others.
@@ -632,36 +654,37 @@ void write_3mf(const std::string& path, const TriMesh& mesh, const ThreeMfInfo& 
       invalid(cat("metadata '", name, "' contains a control character"));
     }
   }
-  if (has_control_character(info.object_name)) {
-    invalid("the object name contains a control character");
-  }
-
   // lib3mf gives every object, item and build a random UUID; deriving them from the content
   // keeps the package byte-identical for identical input (the zip entries carry no timestamps).
   uint64_t hash = 0xcbf29ce484222325ull;
-  hash = fnv1a(hash, vertices.data(), vertices.size() * sizeof(NMR::MODELMESHVERTEX));
-  hash = fnv1a(hash, triangles.data(), triangles.size() * sizeof(NMR::MODELMESHTRIANGLE));
-  hash = fnv1a(hash, info.object_name);
+  for (size_t i = 0; i < parts.size(); ++i) {
+    hash = fnv1a(hash, all_vertices[i].data(), all_vertices[i].size() * sizeof(NMR::MODELMESHVERTEX));
+    hash = fnv1a(hash, all_triangles[i].data(), all_triangles[i].size() * sizeof(NMR::MODELMESHTRIANGLE));
+    hash = fnv1a(hash, parts[i].name);
+  }
   for (const auto& [name, value] : info.metadata) hash = fnv1a(fnv1a(hash, name), value);
 
   const std::string where = cat("cannot write '", path, "'");
-  Handle model, object, item, writer;
+  Handle model, writer;
   check<IoError>(NMR::lib3mf_createmodel(model.out()), nullptr, where);
   check<IoError>(NMR::lib3mf_model_setunit(model.get(), NMR::MODELUNIT_MILLIMETER), model.get(),
                  where);
-  check<IoError>(NMR::lib3mf_model_addmeshobject(model.get(), object.out()), model.get(), where);
-  check<IoError>(NMR::lib3mf_object_setnameutf8(object.get(), info.object_name.c_str()),
-                 object.get(), where);
-  check<IoError>(
-      NMR::lib3mf_meshobject_setgeometry(object.get(), vertices.data(), DWORD(vertices.size()),
-                                         triangles.data(), DWORD(triangles.size())),
-      object.get(), where);
-  check<IoError>(NMR::lib3mf_object_setuuidutf8(object.get(), content_uuid(hash, 1).c_str()),
-                 object.get(), where);
-  check<IoError>(NMR::lib3mf_model_addbuilditem(model.get(), object.get(), nullptr, item.out()),
-                 model.get(), where);
-  check<IoError>(NMR::lib3mf_builditem_setuuidutf8(item.get(), content_uuid(hash, 2).c_str()),
-                 item.get(), where);
+  for (size_t i = 0; i < parts.size(); ++i) {
+    Handle object, item;
+    check<IoError>(NMR::lib3mf_model_addmeshobject(model.get(), object.out()), model.get(), where);
+    check<IoError>(NMR::lib3mf_object_setnameutf8(object.get(), parts[i].name.c_str()),
+                   object.get(), where);
+    check<IoError>(NMR::lib3mf_meshobject_setgeometry(
+                       object.get(), all_vertices[i].data(), DWORD(all_vertices[i].size()),
+                       all_triangles[i].data(), DWORD(all_triangles[i].size())),
+                   object.get(), where);
+    check<IoError>(NMR::lib3mf_object_setuuidutf8(object.get(), content_uuid(hash, i == 0 ? 1 : 2 + 2 * i).c_str()),
+                   object.get(), where);
+    check<IoError>(NMR::lib3mf_model_addbuilditem(model.get(), object.get(), nullptr, item.out()),
+                   model.get(), where);
+    check<IoError>(NMR::lib3mf_builditem_setuuidutf8(item.get(), content_uuid(hash, i == 0 ? 2 : 3 + 2 * i).c_str()),
+                   item.get(), where);
+  }
   check<IoError>(NMR::lib3mf_model_setbuilduuidutf8(model.get(), content_uuid(hash, 3).c_str()),
                  model.get(), where);
   for (const auto& [name, value] : info.metadata) {

@@ -43,11 +43,15 @@ std::vector<MeshComponent> mesh_components(const TriMesh& m) {
   return out;
 }
 
-size_t fill_small_cavities(TriMesh& mesh, double max_volume_mm3) {
+namespace {
+
+// Removes the components `drop_it` picks and the vertices left unused; returns how many.
+template <class Pick>
+size_t drop_components(TriMesh& mesh, Pick&& drop_it) {
   std::vector<char> drop(mesh.triangles.size(), 0);
   size_t removed = 0;
   for (const MeshComponent& c : mesh_components(mesh)) {
-    if (!(c.signed_volume_mm3 < 0 && -c.signed_volume_mm3 < max_volume_mm3)) continue;
+    if (!drop_it(c)) continue;
     ++removed;
     for (uint32_t f : c.triangles) drop[f] = 1;
   }
@@ -69,6 +73,20 @@ size_t fill_small_cavities(TriMesh& mesh, double max_volume_mm3) {
   }
   mesh = std::move(kept);
   return removed;
+}
+
+}  // namespace
+
+size_t fill_small_cavities(TriMesh& mesh, double max_volume_mm3) {
+  return drop_components(mesh, [&](const MeshComponent& c) {
+    return c.signed_volume_mm3 < 0 && -c.signed_volume_mm3 < max_volume_mm3;
+  });
+}
+
+size_t remove_small_specks(TriMesh& mesh, double max_volume_mm3) {
+  return drop_components(mesh, [&](const MeshComponent& c) {
+    return c.signed_volume_mm3 >= 0 && c.signed_volume_mm3 < max_volume_mm3;
+  });
 }
 
 }  // namespace lacuna

@@ -25,4 +25,9 @@ std::vector<MeshComponent> mesh_components(const TriMesh& mesh);
 // marching tetrahedra can close one off from sub-voxel sign changes.
 size_t fill_small_cavities(TriMesh& mesh, double max_volume_mm3);
 
+// Removes the specks: outward shells (components of non-negative volume) enclosing less than
+// `max_volume_mm3`. Below h^3 they are what is left of sub-voxel features (a sliver a drain hole
+// cut off, a wall's corner clipped by a hull): unprintable dust, not part of the design.
+size_t remove_small_specks(TriMesh& mesh, double max_volume_mm3);
+
 }  // namespace lacuna

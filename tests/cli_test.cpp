@@ -139,11 +139,21 @@ TEST_P(Sample, RunsAndEveryOutputPassesTheChecks) {
       for (const char* repaired : {"open_edges", "facets_reversed", "backwards_edges", "degenerate_facets",
                                    "edges_fixed", "facets_removed", "facets_added"})
         EXPECT_EQ(p.out.find(repaired), std::string::npos) << file << ": " << repaired << "\n" << p.out;
-      std::smatch m;
-      ASSERT_TRUE(std::regex_search(p.out, m, std::regex("number_of_facets = ([0-9]+)")));
-      EXPECT_EQ(std::stoull(m[1].str()), o["triangles"].get<uint64_t>());
-      ASSERT_TRUE(std::regex_search(p.out, m, std::regex("volume = ([0-9.eE+-]+)")));
-      EXPECT_NEAR(std::stod(m[1].str()), o["volume_mm3"].get<double>(), 1e-3 * o["volume_mm3"].get<double>());
+      // A 3MF with several objects: PrusaSlicer reports each; the sums are the file's.
+      auto sum_of = [&](const std::string& pattern) {
+        double total = 0;
+        const std::regex re(pattern);
+        for (auto it = std::sregex_iterator(p.out.begin(), p.out.end(), re); it != std::sregex_iterator(); ++it)
+          total += std::stod((*it)[1].str());
+        return total;
+      };
+      const size_t objects = o.contains("objects") ? o["objects"].size() : 1;
+      const std::regex facets_line("number_of_facets = ");
+      EXPECT_EQ(std::distance(std::sregex_iterator(p.out.begin(), p.out.end(), facets_line), std::sregex_iterator()),
+                long(objects))
+          << p.out;
+      EXPECT_EQ(uint64_t(sum_of("number_of_facets = ([0-9]+)")), o["triangles"].get<uint64_t>());
+      EXPECT_NEAR(sum_of("volume = ([0-9.eE+-]+)"), o["volume_mm3"].get<double>(), 1e-3 * o["volume_mm3"].get<double>());
     }
     if (have("admesh") && o["format"] == "stl") {
       Result a = run("admesh " + quote(file), dir.path());
@@ -370,6 +380,16 @@ std::vector<BadCase> bad_cases() {
   const std::string mesh_input = R"({"type": "mesh", "file": "hull.stl"})";
   return {
       {"empty_file", "", "", "", "JSON"},
+      {"group_output_stl", R"({"inputs": {"a": {"type": "sphere", "radius_mm": 2}, "b": {"type": "sphere", "radius_mm": 3}},
+          "outputs": [{"of": ["a", "b"], "file": "ab.stl"}]})", "", "", "needs a .3mf file"},
+      {"group_output_unknown", R"({"inputs": {"a": {"type": "sphere", "radius_mm": 2}},
+          "outputs": [{"of": ["a", "b"], "file": "ab.3mf"}]})", "", "", "\"b\" is not an input"},
+      {"voronoi_tiles_gap", R"({"inputs": {"t": {"type": "voronoi_tiles", "points": [[0.1, 0.2, 0.3]], "period_mm": 10,
+          "clearance_mm": 5}}, "outputs": [{"of": "t", "file": "t.stl"}]})", "", "", "inputs.t.clearance_mm"},
+      {"voronoi_tiles_plate", R"({"inputs": {"t": {"type": "voronoi_tiles", "dimension": 2, "points": [[0.1, 0.2]],
+          "period_mm": 10}}, "outputs": [{"of": "t", "file": "t.stl"}]})", "", "", "thickness_mm"},
+      {"voronoi_foam_cover", R"({"inputs": {"f": {"type": "voronoi_foam", "points": [[0.1, 0.2, 0.3], [0.5, 0.5, 0.5]],
+          "period_mm": 10, "wall_mm": 0.5, "cover": "nothing"}}, "outputs": [{"of": "f", "file": "f.stl"}]})", "", "", "nothing"},
       {"not_json", "hello", "", "", "JSON"},
       {"trailing_comma", R"({"inputs": {}, })", "", "", "JSON"},
       {"top_level_array", "[1, 2]", "", "", "expected an object"},
@@ -552,9 +572,48 @@ TEST(Cli, VoronoiRulesAndCells) {
   Result one = lacuna("voronoi cells --points 0.2,0.7 --level 2 --json", dir.path());
   ASSERT_EQ(one.code, 0) << one.err;
   EXPECT_NEAR(nlohmann::json::parse(one.out)["measures"][0].get<double>(), 1, 1e-12);
+  EXPECT_EQ(nlohmann::json::parse(one.out)["walls"]["facets"], 0);  // one colour: no wall
+  // Two generators on a line: two walls of length 1 (the bisectors x = 1/2 and x = 0).
+  Result two = lacuna("voronoi cells --points " + quote("0.25,0.5;0.75,0.5") + " --level 0 --json", dir.path());
+  ASSERT_EQ(two.code, 0) << two.err;
+  EXPECT_EQ(nlohmann::json::parse(two.out)["walls"]["facets"], 2);
+  EXPECT_NEAR(nlohmann::json::parse(two.out)["walls"]["measure"].get<double>(), 2, 1e-12);
   Result bad = lacuna("voronoi rules --points " + quote("0.2,0.7;1.3,0.1"), dir.path());
   EXPECT_EQ(bad.code, 2);
   EXPECT_NE(bad.err.find("point"), std::string::npos) << bad.err;
+}
+
+// The tiles of one level, meshed and written, fill one period's cube: their volumes plus the clearance
+// (wall area x gap width, from the walls) make period^3; the 3MF holds one object per colour, and
+// the three tiles it holds do not intersect each other (they are checked together as one solid).
+TEST(Cli, VoronoiTilesPartitionThePeriod) {
+  TempDir dir;
+  std::string inputs;
+  for (int c = 1; c <= 3; ++c)
+    inputs += std::string(c > 1 ? "," : "") + "\"t" + std::to_string(c) +
+              R"(": {"type": "voronoi_tiles", "dimension": 3, "points": [[0.2, 0.3, 0.4], [0.7, 0.6, 0.2], [0.4, 0.8, 0.7]],
+                  "level": 1, "period_mm": 10, "clearance_mm": 0.2, "colours": [)" + std::to_string(c) + "]}";
+  write_file(dir / "tiles.json", R"({"voxel_size_mm": 0.1, "inputs": {)" + inputs + R"(},
+    "outputs": [{"of": "t1", "file": "t1.stl"}, {"of": "t2", "file": "t2.stl"}, {"of": "t3", "file": "t3.stl"},
+                {"of": ["t1", "t2", "t3"], "file": "all.3mf"}]})");
+  Result r = lacuna("run " + quote((dir / "tiles.json").string()) + " -o " + quote((dir / "out").string()) + " --json",
+                    dir.path());
+  ASSERT_EQ(r.code, 0) << r.err;
+  nlohmann::json report = nlohmann::json::parse(r.out);
+  double tiles = 0, together = 0;
+  for (const auto& o : report["outputs"]) {
+    EXPECT_TRUE(o["checks"]["valid"].get<bool>()) << o["file"];
+    if (o["format"] == "stl") tiles += o["volume_mm3"].get<double>();
+    else {
+      together = o["volume_mm3"].get<double>();
+      EXPECT_EQ(o["objects"], (nlohmann::json{"t1", "t2", "t3"}));
+    }
+  }
+  const nlohmann::json inputs_report = nlohmann::json::parse(read_file(dir / "out" / "report.json"))["inputs"];
+  const double wall_area = inputs_report["t1"]["wall_area_mm2"].get<double>();
+  EXPECT_GT(wall_area, 100.0);  // at least the cube's worth of faces between three colours
+  EXPECT_NEAR(tiles + wall_area * 0.2, 1000.0, 10.0);
+  EXPECT_NEAR(together, tiles, 1e-6 * tiles);
 }
 
 TEST(Cli, MalformedInputIsRejectedWithExitTwoAndNothingWritten) {

@@ -166,7 +166,7 @@ TEST(CurveSolids, RecipeBsplinePatchOfDegreeOneIsThePlane) {
   }
 }
 
-TEST(CurveSolids, SmallCavitiesAreFilledLargeOnesKept) {
+TEST(CurveSolids, SmallCavitiesAndSpecksAreRemovedLargeOnesKept) {
   // A 10 mm cube with two cube cavities (inward shells): 0.001 mm^3 and 1 mm^3.
   TriMesh m;
   auto add_box = [&](const Vec3d& lo, double a, bool inward) {
@@ -187,6 +187,13 @@ TEST(CurveSolids, SmallCavitiesAreFilledLargeOnesKept) {
   EXPECT_EQ(m.positions_mm.size(), 16u);
   EXPECT_NEAR(signed_volume(m), 1000 - 1, 1e-9);
   EXPECT_EQ(fill_small_cavities(m, 0.01), 0u);
+  // Specks: a separate 0.001 mm^3 cube goes, a 1 mm^3 one stays; the cavity is no speck.
+  add_box({20, 0, 0}, 0.1, false);
+  add_box({30, 0, 0}, 1, false);
+  EXPECT_EQ(remove_small_specks(m, 0.01), 1u);
+  EXPECT_EQ(m.triangles.size(), 36u);
+  EXPECT_NEAR(signed_volume(m), 1000 - 1 + 1, 1e-9);
+  EXPECT_EQ(remove_small_specks(m, 0.01), 0u);
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include "errors.h"
 #include "recipe/recipe.h"
 #include "voronoi/rules.h"
+#include "voronoi/walls.h"
 
 namespace lacuna {
 namespace {
@@ -390,6 +391,121 @@ TEST(VoronoiSpheres, RecipeInputPlacesOneSpherePerKeptGenerator) {
     EXPECT_LT(p.y, 12);
     EXPECT_EQ(p.z, 3);
   }
+}
+
+}  // namespace
+}  // namespace lacuna
+
+namespace lacuna {
+namespace {
+
+// Volume of a closed polyhedron given as face loops (divergence theorem, orientation taken from the sign).
+double piece_volume(const voronoi::ConvexPiece& piece) {
+  double v = 0;
+  for (const auto& f : piece.faces)
+    for (size_t i = 1; i + 1 < f.size(); ++i) {
+      const auto &a = f[0], &b = f[i], &c = f[i + 1];
+      v += (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0])) / 6;
+    }
+  return std::fabs(v);
+}
+
+double piece_area_2d(const voronoi::ConvexPiece& piece) {
+  const auto& p = piece.faces[0];
+  double a = 0;
+  for (size_t i = 0; i < p.size(); ++i) a += p[i][0] * p[(i + 1) % p.size()][1] - p[i][1] * p[(i + 1) % p.size()][0];
+  return a / 2;
+}
+
+TEST(VoronoiWalls, ClosedForms) {
+  // Two generators on a line: the walls are the two bisectors x = 1/2 and x = 0 (= 1), each of measure 1.
+  for (int n : {2, 3}) {
+    std::vector<std::vector<double>> points = {{0.25, 0.5}, {0.75, 0.5}};
+    if (n == 3) points = {{0.25, 0.5, 0.5}, {0.75, 0.5, 0.5}};
+    const Rules rules = voronoi::make_rules(n, 2, points, scaled());
+    const voronoi::Walls walls = voronoi::extract_walls(rules, voronoi::generate_level(rules, 0));
+    EXPECT_EQ(walls.facets.size(), 2u) << n;
+    EXPECT_NEAR(walls.measure, 2.0, 1e-12) << n;
+    EXPECT_EQ(walls.boundary_generators, 2u);
+    for (const auto& f : walls.facets)
+      for (const auto& v : f) EXPECT_NEAR(std::fabs(v[0] - 0.5), 0.5 * (std::fabs(v[0] - 0.5) > 0.25), 1e-12);
+  }
+  // One generator: no other colour, no wall.
+  const Rules one = voronoi::make_rules(2, 3, {{0.4, 0.7}}, scaled());
+  const voronoi::Walls none = voronoi::extract_walls(one, voronoi::generate_level(one, 2));
+  EXPECT_EQ(none.points, 9u * 9u);
+  EXPECT_TRUE(none.facets.empty());
+  EXPECT_EQ(none.boundary_generators, 0u);
+}
+
+// The m-cell-shapes method against every generator's own clipped cell.
+TEST(VoronoiWalls, ShapeMethodMatchesClipping) {
+  struct Case {
+    int n;
+    std::vector<std::vector<double>> points;
+    int max_level;
+  };
+  const std::vector<Case> cases = {{2, kExample, 4}, {3, voronoi::random_points(3, 4, 11), 2}};
+  for (const Case& c : cases) {
+    const Rules rules = voronoi::make_rules(c.n, 2, c.points, scaled());
+    for (int k = 0; k <= c.max_level; ++k) {
+      const Level level = voronoi::generate_level(rules, k);
+      const voronoi::Walls fast = voronoi::extract_walls(rules, level);
+      const voronoi::Walls reference = voronoi::walls_by_clipping(level);
+      EXPECT_EQ(fast.facets.size(), reference.facets.size()) << c.n << "D level " << k;
+      EXPECT_EQ(fast.boundary_generators, reference.boundary_generators) << c.n << "D level " << k;
+      EXPECT_NEAR(fast.measure, reference.measure, 1e-9 * reference.measure) << c.n << "D level " << k;
+      if (k >= 2) {
+        EXPECT_LT(fast.boundary_generators, fast.points);  // the skipped generators exist
+      }
+      // Every wall separates two different colours and a wall's colours are a pair of the colour graph.
+      const auto graph = voronoi::colour_graph(level);
+      for (const auto& pc : fast.colours) {
+        EXPECT_NE(pc.first, pc.second);
+        const std::pair<int, int> key{std::min(pc.first, pc.second), std::max(pc.first, pc.second)};
+        EXPECT_TRUE(std::find(graph.begin(), graph.end(), key) != graph.end());
+      }
+    }
+  }
+  // The literal (shifted) children do not make a lattice: the fast method refuses them.
+  const Rules shifted = voronoi::make_rules(2, 2, kExample);
+  EXPECT_THROW(voronoi::extract_walls(shifted, voronoi::generate_level(shifted, 2)), InvalidInput);
+}
+
+// Without a gap the compact tiles hold exactly the cell measure of their colour, and together a fundamental
+// domain of the torus (measure 1); with a gap, tiles + gap (wall measure x width) still make 1 up to the
+// corners where walls meet.
+TEST(VoronoiTiles, PiecesPartitionAFundamentalDomain) {
+  struct Case {
+    int n;
+    std::vector<std::vector<double>> points;
+    int level;
+  };
+  const std::vector<Case> cases = {{2, kExample, 3}, {3, voronoi::random_points(3, 4, 11), 2}};
+  for (const Case& c : cases) {
+    const Rules rules = voronoi::make_rules(c.n, 2, c.points, scaled());
+    const Level level = voronoi::generate_level(rules, c.level, true);
+    const std::vector<double> measures =
+        c.n == 2 ? voronoi::cell_measures_2d(level) : voronoi::cell_measures_3d(level);
+    const voronoi::Walls walls = voronoi::extract_walls(rules, level);
+    const double half_gap = 1e-3;
+    double total = 0, total_gapped = 0;
+    for (int colour = 0; colour < level.colour_count; ++colour) {
+      double v = 0, vg = 0;
+      for (const auto& piece : voronoi::tile_pieces(rules, level, colour, 0.0))
+        v += c.n == 2 ? piece_area_2d(piece) : piece_volume(piece);
+      for (const auto& piece : voronoi::tile_pieces(rules, level, colour, half_gap))
+        vg += c.n == 2 ? piece_area_2d(piece) : piece_volume(piece);
+      EXPECT_NEAR(v, measures[size_t(colour)], 1e-9) << c.n << "D colour " << colour;
+      EXPECT_LT(vg, v);
+      total += v;
+      total_gapped += vg;
+    }
+    EXPECT_NEAR(total, 1.0, 1e-9);
+    EXPECT_NEAR(total_gapped + walls.measure * 2 * half_gap, 1.0, 0.01);
+  }
+  const Rules rules = voronoi::make_rules(2, 2, kExample, scaled());
+  EXPECT_THROW(voronoi::tile_pieces(rules, voronoi::generate_level(rules, 1), 0, 0.0), InvalidInput);
 }
 
 }  // namespace

@@ -180,6 +180,11 @@ void resolve_inputs(Recipe& recipe, const VolumeOptions& vopt) {
   }
 }
 
+// The objects an output writes: its group, or its one object.
+std::vector<std::string> members(const RecipeOutput& out) {
+  return out.group.empty() ? std::vector<std::string>{out.object} : out.group;
+}
+
 struct Plan {
   std::map<std::string, const RecipeInput*> inputs;
   std::map<std::string, const RecipeOperation*> operations;
@@ -192,7 +197,8 @@ Plan make_plan(const Recipe& recipe) {
   for (const RecipeInput& in : recipe.inputs) plan.inputs[in.name] = &in;
   for (const RecipeOperation& op : recipe.operations) plan.operations[op.name] = &op;
   std::vector<std::string> stack;
-  for (const RecipeOutput& out : recipe.outputs) stack.push_back(out.object);
+  for (const RecipeOutput& out : recipe.outputs)
+    for (const std::string& name : members(out)) stack.push_back(name);
   while (!stack.empty()) {
     std::string name = stack.back();
     stack.pop_back();
@@ -206,7 +212,8 @@ Plan make_plan(const Recipe& recipe) {
       for (const std::string& o : op.operands) ++plan.uses[o];
   std::set<std::string> meshed;
   for (const RecipeOutput& out : recipe.outputs)
-    if (meshed.insert(out.object).second) ++plan.uses[out.object];
+    for (const std::string& name : members(out))
+      if (meshed.insert(name).second) ++plan.uses[name];
   // Material regions of tetrahedral outputs are read after their object is meshed.
   for (const RecipeOutput& out : recipe.outputs)
     for (const std::string& name : out.fea.regions) {
@@ -288,7 +295,8 @@ Estimate estimate(const Recipe& recipe, const Plan& plan, const VolumeOptions& v
     total.voxels += e.active_voxels;
     objects[op.name] = o;
   }
-  for (const RecipeOutput& out : recipe.outputs) mesh_of(objects[out.object].voxels);
+  for (const RecipeOutput& out : recipe.outputs)
+    for (const std::string& name : members(out)) mesh_of(objects[name].voxels);
   return total;
 }
 
@@ -479,7 +487,10 @@ RunResult run_recipe(const std::string& recipe_path, const RunOptions& options) 
     // written file is read back and checked as the file it is.
     std::vector<std::string> objects;
     for (const RecipeOutput& out : recipe.outputs)
-      if (std::find(objects.begin(), objects.end(), out.object) == objects.end()) objects.push_back(out.object);
+      for (const std::string& name : members(out))
+        if (std::find(objects.begin(), objects.end(), name) == objects.end()) objects.push_back(name);
+    // The meshes of a group wait here until its last object is meshed.
+    std::map<const RecipeOutput*, std::map<std::string, TriMesh>> pending;
     for (const std::string& object : objects) {
       timer.start("mesh");
       Volume volume = take(object);
@@ -495,6 +506,7 @@ RunResult run_recipe(const std::string& recipe_path, const RunOptions& options) 
       TriMesh mesh = extract_surface(volume);
       const double h = volume.voxel_size_mm();
       const size_t filled = fill_small_cavities(mesh, h * h * h);
+      const size_t specks = remove_small_specks(mesh, h * h * h);
       volume = Volume();
       if (mesh.triangles.empty())
         throw InvalidInput(recipe.file + ": \"" + object + "\" is empty: nothing is left to export");
@@ -518,6 +530,24 @@ RunResult run_recipe(const std::string& recipe_path, const RunOptions& options) 
       };
       std::vector<Written> written;
       for (const RecipeOutput& out : recipe.outputs) {
+        if (!out.group.empty()) {
+          if (std::find(out.group.begin(), out.group.end(), object) == out.group.end()) continue;
+          std::map<std::string, TriMesh>& parts = pending[&out];
+          parts[object] = surface_for(out.decimate_mm);
+          if (parts.size() < out.group.size()) continue;
+          timer.start("write");
+          const std::string final_path = (out_dir / out.file).string();
+          std::string temp = transaction.stage(final_path);
+          std::vector<ThreeMfObject> objects3mf;
+          for (const std::string& name : out.group) objects3mf.push_back({&parts[name], name});
+          ThreeMfInfo info;
+          info.metadata = {{"Application", "Lacuna " LACUNA_VERSION}, {"Title", recipe.name}};
+          if (!recipe.description.empty()) info.metadata.push_back({"Description", recipe.description});
+          write_3mf(temp, objects3mf, info);
+          pending.erase(&out);
+          written.push_back({&out, temp, final_path});
+          continue;
+        }
         if (out.object != object) continue;
         std::string final_path = (out_dir / out.file).string();
         const TriMesh& surface = surface_for(out.decimate_mm);
@@ -556,6 +586,7 @@ RunResult run_recipe(const std::string& recipe_path, const RunOptions& options) 
         entry["object"] = out.object;
         entry["voxels"] = voxels;
         entry["subvoxel_cavities_filled"] = filled;
+        entry["subvoxel_specks_removed"] = specks;
         annotate(entry, printability, print_problems, hull_volume, out.object);
         outputs.push_back(entry);
         all_valid = all_valid && entry["checks"]["valid"].get<bool>();
@@ -566,15 +597,27 @@ RunResult run_recipe(const std::string& recipe_path, const RunOptions& options) 
       for (const Written& w : written) {
         ReadOptions read;
         read.max_memory_bytes = budget;
+        std::vector<std::string> names;
+        if (!w.out->group.empty()) read.object_names = &names;
         TriMesh back = read_mesh(w.temp, mesh_format_from_path(w.final_path), read);
         MeshCheckReport report = check_mesh(back);
         nlohmann::json entry = check_report_json(report);
         entry["file"] = w.final_path;
         entry["format"] = w.out->format;
         entry["object"] = w.out->object;
+        if (!w.out->group.empty()) {
+          // The package as written holds every object once, in order; together they are checked as one
+          // solid, so they are also free of intersections with each other.
+          entry["objects"] = names;
+          if (names != w.out->group) {
+            entry["checks"]["valid"] = false;
+            entry["checks"]["objects_as_asked"] = false;
+          }
+        }
         entry["part_name"] = w.out->part_name;
         entry["voxels"] = voxels;
         entry["subvoxel_cavities_filled"] = filled;
+        entry["subvoxel_specks_removed"] = specks;
         if (w.out->decimate_mm > 0) entry["decimated_mm"] = w.out->decimate_mm;
         annotate(entry, printability, print_problems, hull_volume, w.out->object);
         outputs.push_back(entry);

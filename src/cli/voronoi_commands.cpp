@@ -8,6 +8,7 @@
 
 #include "errors.h"
 #include "voronoi/rules.h"
+#include "voronoi/walls.h"
 
 namespace lacuna {
 namespace {
@@ -93,9 +94,15 @@ int voronoi_cells(const VoronoiArgs& a) {
   const voronoi::Rules r = rules_of(a);
   const voronoi::Level level = voronoi::generate_level(r, a.level);
   const std::vector<double> measures = a.dimension == 2 ? voronoi::cell_measures_2d(level) : voronoi::cell_measures_3d(level);
+  // The walls between colours (with scaled children: the shifted ones make no lattice to reuse cells on).
+  nlohmann::json walls = nullptr;
+  if (a.children == "scaled") {
+    const voronoi::Walls w = voronoi::extract_walls(r, level);
+    walls = {{"boundary_generators", w.boundary_generators}, {"facets", w.facets.size()}, {"measure", w.measure}};
+  }
   if (a.json) {
     std::cout << nlohmann::json{{"dimension", r.dimension}, {"d", r.d}, {"level", a.level}, {"points", level.points.size()},
-                                {"measures", measures}, {"limit_measures", r.limit_measures}}
+                                {"measures", measures}, {"limit_measures", r.limit_measures}, {"walls", walls}}
                      .dump(1)
               << "\n";
     return kExitOk;
@@ -103,6 +110,10 @@ int voronoi_cells(const VoronoiArgs& a) {
   std::printf("level %d: %zu points\n", a.level, level.points.size());
   for (size_t i = 0; i < measures.size(); ++i)
     std::printf("colour %zu: measure %.9f (limit %.9f)\n", i + 1, measures[i], r.limit_measures[i]);
+  if (!walls.is_null())
+    std::printf("walls: %zu facets carried by %zu of the %zu generators, total %s %.9f\n",
+                walls["facets"].get<size_t>(), walls["boundary_generators"].get<size_t>(), level.points.size(),
+                a.dimension == 2 ? "length" : "area", walls["measure"].get<double>());
   return kExitOk;
 }
 
@@ -110,10 +121,10 @@ int voronoi_cells(const VoronoiArgs& a) {
 
 std::function<int()> add_voronoi_commands(CLI::App& app) {
   auto args = std::make_shared<VoronoiArgs>();
-  CLI::App* voronoi = app.add_subcommand("voronoi", "Fractal Voronoi partitions: substitution rules and cell measures");
+  CLI::App* voronoi = app.add_subcommand("voronoi", "Fractal Voronoi partitions: substitution rules, cell measures and walls");
   voronoi->require_subcommand(1);
   CLI::App* rules = voronoi->add_subcommand("rules", "The substitution rules, their matrix and the limit cell measures");
-  CLI::App* cells = voronoi->add_subcommand("cells", "The measured cell areas (volumes) per colour at a level");
+  CLI::App* cells = voronoi->add_subcommand("cells", "The measured cell areas (volumes) per colour at a level, and the walls between colours");
   for (CLI::App* sub : {rules, cells}) {
     sub->add_option("--dim", args->dimension, "Dimension, 2 or 3")->check(CLI::IsMember({2, 3}));
     sub->add_option("--d", args->d, "Lacunarity d >= 2")->check(CLI::Range(2, 64));

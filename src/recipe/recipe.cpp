@@ -355,11 +355,27 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
     o.allow_only({"of", "file", "name", "decimate_mm", "fea"});
     RecipeOutput out;
     out.json_path = o.path();
-    out.object = o.string("of");
-    if (!names.count(out.object)) {
-      std::string suggestion = closest_match(out.object, std::vector<std::string>(names.begin(), names.end()));
-      o.fail("of", "\"" + out.object + "\" is not an input or operation" +
+    auto known = [&](const std::string& name) {
+      if (names.count(name)) return;
+      std::string suggestion = closest_match(name, std::vector<std::string>(names.begin(), names.end()));
+      o.fail("of", "\"" + name + "\" is not an input or operation" +
                        (suggestion.empty() ? std::string() : "; did you mean \"" + suggestion + "\"?"));
+    };
+    if (o.required("of").is_array()) {
+      // Several objects in one 3MF package.
+      const nlohmann::json& of = o.required("of");
+      if (of.size() < 2) o.fail("of", "expected one name, or a list of two or more names for a 3MF with several objects");
+      for (const auto& n : of) {
+        if (!n.is_string()) o.fail("of", "expected names (strings) of inputs or operations");
+        known(n.get<std::string>());
+        if (std::find(out.group.begin(), out.group.end(), n.get<std::string>()) != out.group.end())
+          o.fail("of", "\"" + n.get<std::string>() + "\" is listed twice");
+        out.group.push_back(n.get<std::string>());
+      }
+      out.object = out.group.front();
+    } else {
+      out.object = o.string("of");
+      known(out.object);
     }
     out.file = o.string("file");
     if (out.file.empty() || out.file.find('/') != std::string::npos || out.file.find('\\') != std::string::npos ||
@@ -373,6 +389,9 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
       o.fail("file", "expected a file name ending in .stl or .3mf (or .msh, .inp, .vtu, .mesh for tetrahedra), got \"" +
                          out.file + "\"");
     out.format = format->second;
+    if (!out.group.empty() && out.format != "3mf")
+      o.fail("of", "a list of objects needs a .3mf file (one object each), got \"" + out.file + "\"");
+    if (!out.group.empty() && o.has("name")) o.fail("name", "the objects of a list are named after their inputs");
     if (lower(out.file) == "report.json" || !files.insert(lower(out.file)).second)
       o.fail("file", "\"" + out.file + "\" is written twice or clashes with report.json");
     out.decimate_mm = o.positive_length_or("decimate_mm", 0.0);

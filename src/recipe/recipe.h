@@ -92,7 +92,10 @@ struct FeaSettings {
 };
 
 struct RecipeOutput {
-  std::string object;     // the input or operation to export
+  std::string object;     // the input or operation to export (of a group: the first)
+  // A 3MF with one object per name (two or more inputs or operations), each named after its input or
+  // operation; empty for a single object.
+  std::vector<std::string> group;
   std::string file;       // a plain file name inside the output folder
   std::string format;     // "stl", "3mf", or a tetrahedral format "msh", "inp", "vtu", "mesh"
   std::string part_name;  // object name inside the file (3MF)

@@ -9,6 +9,7 @@
 
 #include "errors.h"
 #include "util/random.h"
+#include "voronoi/clip.h"
 
 namespace lacuna {
 namespace voronoi {
@@ -127,149 +128,7 @@ void visit_ring(const Grid& grid, const std::array<int, 3>& home, int ring, Visi
   }
 }
 
-using V2 = std::array<double, 2>;
-using V3 = std::array<double, 3>;
-
-// A convex polygon; label[i] is the generator whose bisector carries the edge from vertex i to i + 1.
-struct Polygon2 {
-  std::vector<V2> v;
-  std::vector<int> label;
-};
-
-// Vertices within this distance (torus units) of a clipping line or plane count as on it, so that a second
-// cut along (nearly) the same plane, from a generator that rounding left beside another, changes nothing.
-constexpr double kOnPlane = 1e-13;
-
-// Keeps the part where nx * x + ny * y <= c.
-void clip(Polygon2& poly, double nx, double ny, double c, int label) {
-  const size_t count = poly.v.size();
-  if (count == 0) return;
-  const double eps = kOnPlane * std::hypot(nx, ny);
-  std::vector<double> f(count);
-  bool any_out = false;
-  for (size_t i = 0; i < count; ++i) {
-    f[i] = nx * poly.v[i][0] + ny * poly.v[i][1] - c;
-    any_out = any_out || f[i] > eps;
-  }
-  if (!any_out) return;
-  Polygon2 out;
-  for (size_t i = 0; i < count; ++i) {
-    const size_t k = (i + 1) % count;
-    const bool in_a = f[i] <= eps, in_b = f[k] <= eps;
-    if (in_a) {
-      out.v.push_back(poly.v[i]);
-      out.label.push_back(poly.label[i]);
-    }
-    if (in_a != in_b) {
-      const double t = std::clamp(f[i] / (f[i] - f[k]), 0.0, 1.0);
-      const V2 p{poly.v[i][0] + t * (poly.v[k][0] - poly.v[i][0]), poly.v[i][1] + t * (poly.v[k][1] - poly.v[i][1])};
-      out.v.push_back(p);
-      // Leaving: the new edge runs along the clipping line; entering: along the old edge.
-      out.label.push_back(in_a ? label : poly.label[i]);
-    }
-  }
-  if (out.v.size() < 3) out = Polygon2{};
-  poly = std::move(out);
-}
-
-double area(const Polygon2& poly) {
-  double a = 0;
-  for (size_t i = 0, count = poly.v.size(); i < count; ++i) {
-    const V2& p = poly.v[i];
-    const V2& q = poly.v[(i + 1) % count];
-    a += p[0] * q[1] - p[1] * q[0];
-  }
-  return a / 2;
-}
-
-// A convex polyhedron as its faces (vertex cycles of either orientation), each labelled with the generator
-// whose bisector carries it.
-struct Polyhedron {
-  std::vector<std::vector<V3>> faces;
-  std::vector<int> label;
-};
-
-V3 sub3(const V3& a, const V3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-V3 cross3(const V3& a, const V3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double dot3(const V3& a, const V3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-
-V3 area_vector(const std::vector<V3>& face) {
-  V3 a{0, 0, 0};
-  for (size_t i = 0, count = face.size(); i < count; ++i) {
-    const V3 c = cross3(face[i], face[(i + 1) % count]);
-    for (int j = 0; j < 3; ++j) a[size_t(j)] += c[size_t(j)] / 2;
-  }
-  return a;
-}
-
-// Keeps the part where dot(normal, x) <= c; the cut is closed by a new face labelled `label`.
-void clip(Polyhedron& poly, const V3& normal, double c, int label) {
-  const double eps = kOnPlane * std::sqrt(dot3(normal, normal));
-  bool any_out = false;
-  for (const auto& face : poly.faces)
-    for (const V3& p : face) any_out = any_out || dot3(normal, p) - c > eps;
-  if (!any_out) return;
-  Polyhedron out;
-  std::vector<V3> cap;
-  for (size_t fi = 0; fi < poly.faces.size(); ++fi) {
-    const auto& face = poly.faces[fi];
-    const size_t count = face.size();
-    std::vector<double> f(count);
-    for (size_t i = 0; i < count; ++i) f[i] = dot3(normal, face[i]) - c;
-    std::vector<V3> kept;
-    for (size_t i = 0; i < count; ++i) {
-      const size_t k = (i + 1) % count;
-      const bool in_a = f[i] <= eps, in_b = f[k] <= eps;
-      if (in_a) {
-        kept.push_back(face[i]);
-        if (f[i] >= -eps) cap.push_back(face[i]);
-      }
-      if (in_a != in_b) {
-        const double t = std::clamp(f[i] / (f[i] - f[k]), 0.0, 1.0);
-        const V3 p{face[i][0] + t * (face[k][0] - face[i][0]), face[i][1] + t * (face[k][1] - face[i][1]),
-                   face[i][2] + t * (face[k][2] - face[i][2])};
-        kept.push_back(p);
-        cap.push_back(p);
-      }
-    }
-    if (kept.size() >= 3) {
-      out.faces.push_back(std::move(kept));
-      out.label.push_back(poly.label[fi]);
-    }
-  }
-  if (cap.size() >= 3) {
-    // The cap is convex and lies in the plane: order its points by angle about their mean.
-    V3 centre{0, 0, 0};
-    for (const V3& p : cap)
-      for (int j = 0; j < 3; ++j) centre[size_t(j)] += p[size_t(j)] / double(cap.size());
-    // The axis least aligned with the normal.
-    const double ax = std::fabs(normal[0]), ay = std::fabs(normal[1]), az = std::fabs(normal[2]);
-    const V3 helper = ax <= ay && ax <= az ? V3{1, 0, 0} : (ay <= az ? V3{0, 1, 0} : V3{0, 0, 1});
-    const V3 e1 = cross3(normal, helper);
-    const V3 e2 = cross3(normal, e1);
-    std::vector<std::pair<double, V3>> sorted;
-    for (const V3& p : cap) {
-      const V3 r = sub3(p, centre);
-      sorted.push_back({std::atan2(dot3(r, e2), dot3(r, e1)), p});
-    }
-    std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    std::vector<V3> face;
-    for (const auto& s : sorted) face.push_back(s.second);
-    out.faces.push_back(std::move(face));
-    out.label.push_back(label);
-  }
-  if (out.faces.size() < 4) out = Polyhedron{};
-  poly = std::move(out);
-}
-
-// Pyramids from a point inside the convex polyhedron.
-double volume(const Polyhedron& poly, const V3& inside) {
-  double v = 0;
-  for (const auto& face : poly.faces) v += std::fabs(dot3(area_vector(face), sub3(face[0], inside))) / 3;
-  return v;
-}
+using namespace detail;
 
 void check_level(const Level& level, int n) {
   if (level.dimension != n)
@@ -288,96 +147,116 @@ void check_level(const Level& level, int n) {
   }
 }
 
-struct CellScan {
-  std::vector<double> measures;         // per colour
-  std::set<std::pair<int, int>> graph;  // colour pairs sharing a wall
+// The periodic Voronoi cell of one generator, by clipping the torus box around it with the bisectors of the
+// generator copies in growing rings of grid buckets. Every unprocessed copy lies at least ring / g from the
+// generator after rings 0 .. ring (the generator's bucket is at least that far inside the block of scanned
+// buckets), so its bisector lies at least ring / (2 g) away and cannot cut a cell whose farthest vertex is
+// nearer: the cell is exact when the loop stops.
+struct CellWork {
+  Polygon2 poly2;                       // n = 2
+  Polyhedron poly3;                     // n = 3
+  std::vector<Neighbour> neighbours;    // the labels of poly2 / poly3 index this
+  std::vector<int> coincident;          // other generators at the same place (the construction makes them for d = 2)
 };
 
-// Every unprocessed generator copy lies at least ring / g from the generator after rings 0 .. ring (the
-// generator's bucket is at least that far inside the block of scanned buckets), so its bisector lies at
-// least ring / (2 g) away and cannot cut a cell whose farthest vertex is nearer.
-CellScan scan_cells(const Level& level, int n, bool want_graph) {
-  check_level(level, n);
-  const Grid grid = make_grid(level);
+void build_cell(const Level& level, const Grid& grid, size_t self, CellWork& w) {
+  const int n = level.dimension;
   const double h = 1.0 / grid.g;
-  CellScan scan;
-  scan.measures.assign(size_t(level.colour_count), 0.0);
   const auto& pts = level.points;
-  for (size_t self = 0; self < pts.size(); ++self) {
-    const auto& x = pts[self];
-    std::array<int, 3> home{0, 0, 0};
-    for (int j = 0; j < n; ++j) home[size_t(j)] = grid.cell_of(x[size_t(j)]);
-    std::vector<int> coincident;  // other generators at the same place (the construction makes them for d = 2)
-    Polygon2 poly2;
-    Polyhedron poly3;
-    if (n == 2) {
-      poly2.v = {
-          {x[0] - 0.5, x[1] - 0.5}, {x[0] + 0.5, x[1] - 0.5}, {x[0] + 0.5, x[1] + 0.5}, {x[0] - 0.5, x[1] + 0.5}};
-      poly2.label.assign(4, int(self));
-    } else {
-      const double x0 = x[0] - 0.5, x1 = x[0] + 0.5, y0 = x[1] - 0.5, y1 = x[1] + 0.5, z0 = x[2] - 0.5, z1 = x[2] + 0.5;
-      poly3.faces = {{{x0, y0, z0}, {x0, y1, z0}, {x0, y1, z1}, {x0, y0, z1}},
+  const auto& x = pts[self];
+  std::array<int, 3> home{0, 0, 0};
+  for (int j = 0; j < n; ++j) home[size_t(j)] = grid.cell_of(x[size_t(j)]);
+  w.coincident.clear();
+  w.neighbours.clear();
+  const int me = int(self);
+  // The box's faces are the bisectors with the generator's own copies one period away.
+  if (n == 2) {
+    w.poly2.v = {{x[0] - 0.5, x[1] - 0.5}, {x[0] + 0.5, x[1] - 0.5}, {x[0] + 0.5, x[1] + 0.5}, {x[0] - 0.5, x[1] + 0.5}};
+    w.neighbours = {{me, {0, -1, 0}}, {me, {1, 0, 0}}, {me, {0, 1, 0}}, {me, {-1, 0, 0}}};
+    w.poly2.label = {0, 1, 2, 3};
+  } else {
+    const double x0 = x[0] - 0.5, x1 = x[0] + 0.5, y0 = x[1] - 0.5, y1 = x[1] + 0.5, z0 = x[2] - 0.5, z1 = x[2] + 0.5;
+    w.poly3.faces = {{{x0, y0, z0}, {x0, y1, z0}, {x0, y1, z1}, {x0, y0, z1}},
                      {{x1, y0, z0}, {x1, y1, z0}, {x1, y1, z1}, {x1, y0, z1}},
                      {{x0, y0, z0}, {x1, y0, z0}, {x1, y0, z1}, {x0, y0, z1}},
                      {{x0, y1, z0}, {x1, y1, z0}, {x1, y1, z1}, {x0, y1, z1}},
                      {{x0, y0, z0}, {x1, y0, z0}, {x1, y1, z0}, {x0, y1, z0}},
                      {{x0, y0, z1}, {x1, y0, z1}, {x1, y1, z1}, {x0, y1, z1}}};
-      poly3.label.assign(6, int(self));
-    }
-    for (int ring = 0;; ++ring) {
-      visit_ring(grid, home, ring, [&](int t, const std::array<double, 3>& shift) {
-        if (size_t(t) == self) return;
-        std::array<double, 3> y{0, 0, 0}, normal{0, 0, 0};
-        double c = 0;
-        double length2 = 0;
-        for (int j = 0; j < n; ++j) {
-          y[size_t(j)] = pts[size_t(t)][size_t(j)] + shift[size_t(j)];
-          normal[size_t(j)] = y[size_t(j)] - x[size_t(j)];
-          c += normal[size_t(j)] * (y[size_t(j)] + x[size_t(j)]) / 2;
-          length2 += normal[size_t(j)] * normal[size_t(j)];
-        }
-        if (length2 <= kCoincident * kCoincident) {
-          if (std::find(coincident.begin(), coincident.end(), t) == coincident.end()) coincident.push_back(t);
-          return;
-        }
-        if (n == 2)
-          clip(poly2, normal[0], normal[1], c, t);
-        else
-          clip(poly3, normal, c, t);
-      });
-      double r2 = 0;
-      if (n == 2) {
-        for (const V2& p : poly2.v) r2 = std::max(r2, (p[0] - x[0]) * (p[0] - x[0]) + (p[1] - x[1]) * (p[1] - x[1]));
-      } else {
-        const V3 xs{x[0], x[1], x[2]};
-        for (const auto& face : poly3.faces)
-          for (const V3& p : face) r2 = std::max(r2, dot3(sub3(p, xs), sub3(p, xs)));
+    w.neighbours = {{me, {-1, 0, 0}}, {me, {1, 0, 0}}, {me, {0, -1, 0}},
+                    {me, {0, 1, 0}},  {me, {0, 0, -1}}, {me, {0, 0, 1}}};
+    w.poly3.label = {0, 1, 2, 3, 4, 5};
+  }
+  for (int ring = 0;; ++ring) {
+    visit_ring(grid, home, ring, [&](int t, const std::array<double, 3>& shift) {
+      if (size_t(t) == self) return;
+      std::array<double, 3> y{0, 0, 0}, normal{0, 0, 0};
+      double c = 0;
+      double length2 = 0;
+      for (int j = 0; j < n; ++j) {
+        y[size_t(j)] = pts[size_t(t)][size_t(j)] + shift[size_t(j)];
+        normal[size_t(j)] = y[size_t(j)] - x[size_t(j)];
+        c += normal[size_t(j)] * (y[size_t(j)] + x[size_t(j)]) / 2;
+        length2 += normal[size_t(j)] * normal[size_t(j)];
       }
-      // The 1e-12 margin covers a generator that rounding placed in a neighbouring bucket.
-      if (2 * std::sqrt(r2) + 1e-12 <= ring * h) break;
+      if (length2 <= kCoincident * kCoincident) {
+        if (std::find(w.coincident.begin(), w.coincident.end(), t) == w.coincident.end()) w.coincident.push_back(t);
+        return;
+      }
+      const int label = int(w.neighbours.size());
+      w.neighbours.push_back({t, {int(shift[0]), int(shift[1]), int(shift[2])}});
+      const bool cut = n == 2 ? clip(w.poly2, normal[0], normal[1], c, label) : clip(w.poly3, normal, c, label);
+      if (!cut) w.neighbours.pop_back();
+    });
+    double r2 = 0;
+    if (n == 2) {
+      for (const V2& p : w.poly2.v) r2 = std::max(r2, (p[0] - x[0]) * (p[0] - x[0]) + (p[1] - x[1]) * (p[1] - x[1]));
+    } else {
+      const V3 xs{x[0], x[1], x[2]};
+      for (const auto& face : w.poly3.faces)
+        for (const V3& p : face) r2 = std::max(r2, dot3(sub3(p, xs), sub3(p, xs)));
     }
+    // The 1e-12 margin covers a generator that rounding placed in a neighbouring bucket.
+    if (2 * std::sqrt(r2) + 1e-12 <= ring * h) break;
+  }
+}
+
+struct CellScan {
+  std::vector<double> measures;         // per colour
+  std::set<std::pair<int, int>> graph;  // colour pairs sharing a wall
+};
+
+CellScan scan_cells(const Level& level, int n, bool want_graph) {
+  check_level(level, n);
+  const Grid grid = make_grid(level);
+  CellScan scan;
+  scan.measures.assign(size_t(level.colour_count), 0.0);
+  CellWork w;
+  for (size_t self = 0; self < level.points.size(); ++self) {
+    build_cell(level, grid, self, w);
+    const auto& x = level.points[self];
     const int colour = level.colours[self];
-    const double share = 1.0 / double(coincident.size() + 1);
-    for (int t : coincident) {
+    const double share = 1.0 / double(w.coincident.size() + 1);
+    auto other_colour = [&](int label) { return level.colours[size_t(w.neighbours[size_t(label)].generator)]; };
+    for (int t : w.coincident) {
       const int other = level.colours[size_t(t)];
       if (want_graph && other != colour) scan.graph.insert({std::min(colour, other), std::max(colour, other)});
     }
     if (n == 2) {
-      scan.measures[size_t(colour)] += share * area(poly2);
+      scan.measures[size_t(colour)] += share * area(w.poly2);
       if (want_graph)
-        for (size_t i = 0; i < poly2.v.size(); ++i) {
-          const int other = level.colours[size_t(poly2.label[i])];
-          const V2& p = poly2.v[i];
-          const V2& q = poly2.v[(i + 1) % poly2.v.size()];
+        for (size_t i = 0; i < w.poly2.v.size(); ++i) {
+          const int other = other_colour(w.poly2.label[i]);
+          const V2& p = w.poly2.v[i];
+          const V2& q = w.poly2.v[(i + 1) % w.poly2.v.size()];
           if (other != colour && std::hypot(q[0] - p[0], q[1] - p[1]) > 1e-12)
             scan.graph.insert({std::min(colour, other), std::max(colour, other)});
         }
     } else {
-      scan.measures[size_t(colour)] += share * volume(poly3, {x[0], x[1], x[2]});
+      scan.measures[size_t(colour)] += share * volume(w.poly3, {x[0], x[1], x[2]});
       if (want_graph)
-        for (size_t i = 0; i < poly3.faces.size(); ++i) {
-          const int other = level.colours[size_t(poly3.label[i])];
-          const V3 a = area_vector(poly3.faces[i]);
+        for (size_t i = 0; i < w.poly3.faces.size(); ++i) {
+          const int other = other_colour(w.poly3.label[i]);
+          const V3 a = area_vector(w.poly3.faces[i]);
           if (other != colour && std::sqrt(dot3(a, a)) > 1e-12)
             scan.graph.insert({std::min(colour, other), std::max(colour, other)});
         }
@@ -392,16 +271,17 @@ Level level_zero(const Rules& rules) {
   level.colour_count = int(rules.points.size());
   level.points = rules.points;
   for (size_t i = 0; i < rules.points.size(); ++i) level.colours.push_back(int(i));
+  level.shapes = level.colours;
   return level;
 }
 
 void sub(const Rules& rules, int i, int k, int s, int c, const std::vector<double>& p, const std::vector<double>& scale,
-         Level& level) {
+         bool keep_unwrapped, Level& level) {
   if (i < k) {
     std::vector<double> child(p.size());
     for (const Rule& rule : rules.rules[size_t(c)]) {
       for (size_t j = 0; j < p.size(); ++j) child[j] = p[j] + rule.offset[j] * scale[size_t(i)];
-      sub(rules, i + 1, k, s, rule.follows, child, scale, level);
+      sub(rules, i + 1, k, s, rule.follows, child, scale, keep_unwrapped, level);
     }
     return;
   }
@@ -409,6 +289,8 @@ void sub(const Rules& rules, int i, int k, int s, int c, const std::vector<doubl
   for (size_t j = 0; j < p.size(); ++j) q[j] = wrap(p[j]);
   level.points.push_back(std::move(q));
   level.colours.push_back(s);
+  level.shapes.push_back(c);
+  if (keep_unwrapped) level.unwrapped.push_back(p);
 }
 
 }  // namespace
@@ -504,7 +386,7 @@ std::vector<std::vector<double>> random_points(int n, int m, uint64_t seed) {
   return points;
 }
 
-Level generate_level(const Rules& rules, int k) {
+Level generate_level(const Rules& rules, int k, bool keep_unwrapped) {
   if (k < 0) throw InvalidInput("voronoi: the level must be >= 0, got " + std::to_string(k));
   const double dn = std::pow(double(rules.d), rules.dimension);
   const double count = std::pow(dn, k) * double(rules.points.size());
@@ -516,15 +398,61 @@ Level generate_level(const Rules& rules, int k) {
   Level level = level_zero(rules);
   level.points.clear();
   level.colours.clear();
+  level.shapes.clear();
   level.points.reserve(size_t(count));
   level.colours.reserve(size_t(count));
-  for (size_t c = 0; c < rules.points.size(); ++c) sub(rules, 0, k, int(c), int(c), rules.points[c], scale, level);
+  level.shapes.reserve(size_t(count));
+  if (keep_unwrapped) level.unwrapped.reserve(size_t(count));
+  for (size_t c = 0; c < rules.points.size(); ++c)
+    sub(rules, 0, k, int(c), int(c), rules.points[c], scale, keep_unwrapped, level);
   return level;
 }
 
 std::vector<double> cell_measures_2d(const Level& level) { return scan_cells(level, 2, false).measures; }
 
 std::vector<double> cell_measures_3d(const Level& level) { return scan_cells(level, 3, false).measures; }
+
+std::vector<Cell> periodic_cells(const Level& level) {
+  if (level.dimension != 2 && level.dimension != 3)
+    throw InvalidInput("voronoi: a level must be 2D or 3D, got " + std::to_string(level.dimension));
+  const int n = level.dimension;
+  check_level(level, n);
+  const Grid grid = make_grid(level);
+  std::vector<Cell> cells(level.points.size());
+  CellWork w;
+  for (size_t self = 0; self < level.points.size(); ++self) {
+    build_cell(level, grid, self, w);
+    Cell& cell = cells[self];
+    cell.coincident = w.coincident;
+    const auto& x = level.points[self];
+    if (n == 2) {
+      const size_t count = w.poly2.v.size();
+      for (size_t i = 0; i < count; ++i) {
+        const V2& p = w.poly2.v[i];
+        const V2& q = w.poly2.v[(i + 1) % count];
+        if (std::hypot(q[0] - p[0], q[1] - p[1]) <= 1e-15) continue;
+        cell.faces.push_back({{p[0], p[1], 0.0}, {q[0], q[1], 0.0}});
+        cell.across.push_back(w.neighbours[size_t(w.poly2.label[i])]);
+      }
+    } else {
+      const V3 xs{x[0], x[1], x[2]};
+      for (size_t i = 0; i < w.poly3.faces.size(); ++i) {
+        std::vector<V3> face;
+        for (const V3& p : w.poly3.faces[i])
+          if (face.empty() || std::sqrt(dot3(sub3(p, face.back()), sub3(p, face.back()))) > 1e-15) face.push_back(p);
+        while (face.size() > 1 && std::sqrt(dot3(sub3(face.front(), face.back()), sub3(face.front(), face.back()))) <= 1e-15)
+          face.pop_back();
+        if (face.size() < 3) continue;
+        const V3 a = area_vector(face);
+        if (std::sqrt(dot3(a, a)) <= 1e-24) continue;
+        if (dot3(a, sub3(face[0], xs)) < 0) std::reverse(face.begin(), face.end());
+        cell.faces.push_back(std::move(face));
+        cell.across.push_back(w.neighbours[size_t(w.poly3.label[i])]);
+      }
+    }
+  }
+  return cells;
+}
 
 std::vector<std::pair<int, int>> colour_graph(const Level& level) {
   if (level.dimension != 2 && level.dimension != 3)

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <array>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -67,11 +68,17 @@ struct Level {
   int colour_count = 0;                     // m
   std::vector<std::vector<double>> points;  // wrapped into [0,1)^n, in the order of the spec's Sub recursion
   std::vector<int> colours;                 // 0-based colour (starting point) of each point
+  // The starting point whose rule each point followed last: with scaled children the point is
+  // (p(shape) + z) / d^k for an integer vector z, so its Voronoi cell is that starting point's cell scaled.
+  std::vector<int> shapes;
+  // The positions before wrapping (only when asked for): each colour's points form one compact tile around its
+  // starting point instead of being scattered over the torus.
+  std::vector<std::vector<double>> unwrapped;
 };
 
 // P^k by the spec's recursion Sub: (d^n)^k m points. Throws InvalidInput for k < 0 and ResourceLimit when
 // the level would hold more than 20 000 000 points.
-Level generate_level(const Rules& rules, int k);
+Level generate_level(const Rules& rules, int k, bool keep_unwrapped = false);
 
 // The measure of each colour's union of periodic Voronoi cells at a 2D level, exactly (each cell is the
 // torus square around its generator clipped by the bisectors of every generator copy that can reach it), so
@@ -82,6 +89,25 @@ std::vector<double> cell_measures_2d(const Level& level);
 
 // The same in 3D with convex polyhedron clipping (the torus cube around each generator).
 std::vector<double> cell_measures_3d(const Level& level);
+
+// The generator across one face of a periodic Voronoi cell: its index in the level and the whole periods
+// added to its wrapped position (the copy whose bisector carries the face).
+struct Neighbour {
+  int generator = 0;
+  std::array<int, 3> shift{0, 0, 0};
+};
+
+// The periodic Voronoi cell of one generator, around its wrapped position (it may reach outside [0,1)^n).
+struct Cell {
+  // 3D: the convex faces, counter-clockwise seen from outside; 2D: the polygon's edges in counter-clockwise
+  // order, each as its two end points (third coordinate 0).
+  std::vector<std::vector<std::array<double, 3>>> faces;
+  std::vector<Neighbour> across;  // one per face
+  std::vector<int> coincident;    // other generators at the same site (they share the cell)
+};
+
+// Every generator's cell, clipped exactly (see cell_measures_2d). Throws InvalidInput as the cell measures do.
+std::vector<Cell> periodic_cells(const Level& level);
 
 // The neighbourhood graph of a level (2D or 3D): the pairs (c1, c2), c1 < c2, of colours whose cells share
 // an edge (2D) or a face (3D) of positive size (more than 1e-12 of the torus side, squared in 3D), sorted.
