@@ -380,6 +380,10 @@ std::vector<BadCase> bad_cases() {
   const std::string mesh_input = R"({"type": "mesh", "file": "hull.stl"})";
   return {
       {"empty_file", "", "", "", "JSON"},
+      {"bcifs_bad_edge", R"({"inputs": {"p": {"type": "bcifs_plate", "face": {"boundary": "C2 Q2 C2"}, "radius_mm": 5}},
+          "outputs": [{"of": "p", "file": "p.stl"}]})", "", "", "inputs.p.face.boundary"},
+      {"bcifs_control_count", R"({"inputs": {"p": {"type": "bcifs_plate", "face": {"boundary": "C2 B2 C2",
+          "control_mm": [[0, 0], [1, 0]]}}}, "outputs": [{"of": "p", "file": "p.stl"}]})", "", "", "expected 3 points"},
       {"group_output_stl", R"({"inputs": {"a": {"type": "sphere", "radius_mm": 2}, "b": {"type": "sphere", "radius_mm": 3}},
           "outputs": [{"of": ["a", "b"], "file": "ab.stl"}]})", "", "", "needs a .3mf file"},
       {"group_output_unknown", R"({"inputs": {"a": {"type": "sphere", "radius_mm": 2}},
@@ -614,6 +618,58 @@ TEST(Cli, VoronoiTilesPartitionThePeriod) {
   EXPECT_GT(wall_area, 100.0);  // at least the cube's worth of faces between three colours
   EXPECT_NEAR(tiles + wall_area * 0.2, 1000.0, 10.0);
   EXPECT_NEAR(together, tiles, 1e-6 * tiles);
+}
+
+// `bcifs rules` on the note's examples; a plate's volume is its region's area (polygon formula) times its
+// thickness; `bcifs measure` gives N^C_i = 6^i for F0 and writes its two PNG files.
+TEST(Cli, BcifsRulesPlateAndMeasure) {
+  TempDir dir;
+  Result f0 = lacuna("bcifs rules --boundary " + quote("C2 B2 C2 B2 C2 B2") + " --params " + quote("C2 B2 B2") + " --json",
+                     dir.path());
+  ASSERT_EQ(f0.code, 0) << f0.err;
+  nlohmann::json j = nlohmann::json::parse(f0.out);
+  EXPECT_EQ(j["lacunas_1"], 2.5);
+  EXPECT_EQ(j["subfaces_1"], 6);
+  EXPECT_NEAR(j["r_limit"].get<double>(), 1.0 / 3, 1e-12);
+  EXPECT_EQ(j["face_types"].size(), 1u);
+  EXPECT_EQ(j["face_types"][0]["children"], (nlohmann::json{0, 0, 0, 0, 0, 0}));
+  Result worked = lacuna("bcifs rules --boundary " + quote("C4 B2 C2 B2 C3 B2") + " --json", dir.path());
+  ASSERT_EQ(worked.code, 0) << worked.err;
+  const nlohmann::json w = nlohmann::json::parse(worked.out);
+  EXPECT_EQ(w["lacunas_1"], 4);  // one lacuna + (4 - 1 + 2 - 1 + 3 - 1) / 2 half lacunas
+  EXPECT_EQ(w["subfaces_1"], 9);
+  Result bad = lacuna("bcifs rules --boundary " + quote("C4 X2"), dir.path());
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("X2"), std::string::npos) << bad.err;
+
+  write_file(dir / "plate.json", R"({"voxel_size_mm": 0.08, "inputs": {"plate": {"type": "bcifs_plate",
+      "face": {"boundary": "C2 B2 C2 B2 C2 B2"}, "radius_mm": 8, "level": 2, "thickness_mm": 1}},
+      "outputs": [{"of": "plate", "file": "plate.stl"}]})");
+  Result run = lacuna("run " + quote((dir / "plate.json").string()) + " -o " + quote((dir / "out").string()) + " --json",
+                      dir.path());
+  ASSERT_EQ(run.code, 0) << run.err;
+  const nlohmann::json out = nlohmann::json::parse(run.out)["outputs"][0];
+  EXPECT_TRUE(out["checks"]["valid"].get<bool>());
+  const nlohmann::json in = nlohmann::json::parse(read_file(dir / "out" / "report.json"))["inputs"]["plate"];
+  // N^L_2 = 17.5 lacunas: 9 halves are notches in the outer boundary (3 gaps on each of the three C2 edges); the
+  // other 13 are holes: the face's lacuna, one in each sub-face and one where the gaps of the six C2 adjacency
+  // edges meet from both sides.
+  EXPECT_EQ(in["holes"], 17.5 - 9 * 0.5);
+  EXPECT_NEAR(out["volume_mm3"].get<double>(), in["area_mm2"].get<double>() * 1.0, 0.01 * in["area_mm2"].get<double>());
+
+  Result m = lacuna("bcifs measure " + quote((dir / "plate.json").string()) + " --levels 0..3 -o " +
+                        quote((dir / "m").string()) + " --json",
+                    dir.path());
+  ASSERT_EQ(m.code, 0) << m.err;
+  const nlohmann::json mj = nlohmann::json::parse(m.out)["plate"];
+  EXPECT_EQ(mj["topology"][0]["subfaces"], (nlohmann::json{1, 6, 36, 216}));
+  EXPECT_EQ(mj["topology"][0]["lacunas"], (nlohmann::json{0, 2.5, 2.5 + 6 * 2.5, 2.5 + 6 * (2.5 + 6 * 2.5)}));
+  // A_0: the regular hexagon of circumradius 8.
+  EXPECT_NEAR(mj["area_mm2"][0].get<double>(), 1.5 * std::sqrt(3.0) * 64, 1e-9);
+  EXPECT_NEAR(mj["perimeter_mm"][0].get<double>(), 48, 1e-9);
+  EXPECT_TRUE(fs::exists(dir / "m" / "plate_density.png"));
+  EXPECT_TRUE(fs::exists(dir / "m" / "plate_plot.png"));
+  EXPECT_EQ(read_file(dir / "m" / "plate_plot.png").substr(1, 3), "PNG");
 }
 
 TEST(Cli, MalformedInputIsRejectedWithExitTwoAndNothingWritten) {

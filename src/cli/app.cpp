@@ -14,6 +14,7 @@
 #include "cli/cifs_commands.h"
 #include "cli/curve_commands.h"
 #include "cli/fill_commands.h"
+#include "cli/bcifs_commands.h"
 #include "cli/voronoi_commands.h"
 #include "cli/fea_output.h"
 #include "cli/run_recipe.h"
@@ -293,6 +294,7 @@ int run_app(int argc, char** argv) {
   std::function<int()> curve_command = add_curve_commands(app);
   std::function<int()> fill_command = add_fill_commands(app);
   std::function<int()> voronoi_command = add_voronoi_commands(app);
+  std::function<int()> bcifs_command = add_bcifs_commands(app);
 
   try {
     app.parse(argc, argv);
@@ -312,7 +314,7 @@ int run_app(int argc, char** argv) {
     }
     if (*check) return command_check(mesh_path, flags, print);
     if (*fea) return command_fea(fea_args, run_options, flags);
-    for (const auto& command : {cifs_command, curve_command, fill_command, voronoi_command}) {
+    for (const auto& command : {cifs_command, curve_command, fill_command, voronoi_command, bcifs_command}) {
       const int code = command();
       if (code >= 0) return code;
     }

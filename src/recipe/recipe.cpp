@@ -9,6 +9,7 @@
 #include <set>
 #include <sstream>
 
+#include "bcifs/recipe_input.h"
 #include "cifs/solid_input.h"
 #include "curves/recipe_input.h"
 #include "fill/recipe_input.h"
@@ -82,6 +83,7 @@ void register_builtin_types() {
   curves::register_recipe_inputs();
   fill::register_recipe_inputs();
   voronoi::register_recipe_inputs();
+  bcifs::register_recipe_inputs();
   register_input_type({"sphere", {"center_mm", "radius_mm"}, [](const JsonObject& o, RecipeInput& in) {
                          in.geometry.spheres.centers_mm.push_back(o.vec3_or("center_mm", Vec3d{}));
                          in.geometry.spheres.radii_mm.push_back(o.positive_length("radius_mm"));

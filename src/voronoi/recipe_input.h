@@ -1,5 +1,6 @@
-// The `voronoi_spheres` recipe input: spheres centred on the generators of a fractal Voronoi level
-// (clusters, granular structures).
+// The fractal Voronoi recipe inputs: `voronoi_spheres` (spheres on the generators of a level: clusters,
+// granular structures), `voronoi_tiles` (each colour's compact tile, with a clearance) and `voronoi_foam`
+// (the walls between colours, thickened).
 #pragma once
 
 namespace lacuna {

@@ -1,0 +1,215 @@
+#include "bcifs/recipe_input.h"
+
+#include <cmath>
+#include <map>
+#include <string>
+#include <utility>
+
+#include "errors.h"
+#include "recipe/json_fields.h"
+#include "recipe/recipe.h"
+
+namespace lacuna {
+namespace bcifs {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kMaxLeaves = 2e6;
+
+FaceType parse_face(const JsonObject& f) {
+  f.allow_only({"boundary", "params", "algorithm", "delay", "control_mm"});
+  FaceType face;
+  try {
+    face.boundary = parse_boundary(f.string("boundary"));
+  } catch (const InvalidInput& e) {
+    f.fail("boundary", e.what());
+  }
+  try {
+    face.edges = parse_edge_set(f.string_or("params", "C2 B2 B2"));
+  } catch (const InvalidInput& e) {
+    f.fail("params", e.what());
+  }
+  try {
+    face.algorithm = parse_algorithm(f.string_or("algorithm", "A1"));
+  } catch (const InvalidInput& e) {
+    f.fail("algorithm", e.what());
+  }
+  const uint64_t delay = f.unsigned_integer_or("delay", 1);
+  if (delay < 1 || delay > 16) f.fail("delay", "expected a delay from 1 to 16");
+  face.delay = int(delay);
+  try {
+    validate(face);
+  } catch (const InvalidInput& e) {
+    f.fail("", e.what());
+  }
+  return face;
+}
+
+std::vector<Vec2d> parse_control(const JsonObject& f, size_t edges, double radius) {
+  std::vector<Vec2d> control;
+  if (!f.has("control_mm")) {
+    if (radius <= 0) f.fail("control_mm", "expected one [x, y] per boundary edge (or \"radius_mm\" for a regular polygon)");
+    for (size_t j = 0; j < edges; ++j) {
+      const double a = 2 * kPi * double(j) / double(edges);
+      control.push_back({radius * std::cos(a), radius * std::sin(a)});
+    }
+    return control;
+  }
+  control = f.vec2_list(f.required("control_mm"), f.path_of("control_mm"));
+  if (control.size() != edges)
+    f.fail("control_mm", "expected " + std::to_string(edges) + " points (one per boundary edge), got " +
+                             std::to_string(control.size()));
+  double area = 0;
+  for (size_t j = 0; j < edges; ++j) {
+    const Vec2d& p = control[j];
+    const Vec2d& q = control[(j + 1) % edges];
+    area += p.x * q.y - p.y * q.x;
+  }
+  if (!(area > 0)) f.fail("control_mm", "expected a counter-clockwise polygon of positive area");
+  return control;
+}
+
+double fraction(const JsonObject& o, const char* key, double fallback) {
+  const double v = o.number_or(key, fallback);
+  if (!(v > 0 && v < 1)) o.fail(key, "expected a fraction strictly between 0 and 1");
+  return v;
+}
+
+}  // namespace
+
+PlateSpec parse_plate(const JsonObject& o) {
+  PlateSpec spec;
+  if (o.has("face") == o.has("faces")) o.fail("", "give either \"face\" (one lacunar face) or \"faces\" (an assembly)");
+  const double radius = o.has("radius_mm") ? o.positive_length("radius_mm") : 0.0;
+  if (o.has("face")) {
+    if (o.has("shared")) o.fail("shared", "shared edges need \"faces\"");
+    const JsonObject f = o.object("face");
+    spec.assembly.faces.push_back(parse_face(f));
+    spec.controls.push_back(parse_control(f, spec.assembly.faces[0].boundary.size(), radius));
+  } else {
+    const nlohmann::json& list = o.required("faces");
+    if (!list.is_array() || list.empty()) o.fail("faces", "expected a list of faces");
+    for (size_t i = 0; i < list.size(); ++i) {
+      const JsonObject f(list[i], o.file(), o.path_of("faces") + "[" + std::to_string(i) + "]");
+      spec.assembly.faces.push_back(parse_face(f));
+      spec.controls.push_back(parse_control(f, spec.assembly.faces.back().boundary.size(), list.size() == 1 ? radius : 0));
+    }
+    if (o.has("shared")) {
+      const nlohmann::json& shared = o.required("shared");
+      if (!shared.is_array()) o.fail("shared", "expected a list of {face_a, edge_a, face_b, edge_b} (0-based)");
+      for (size_t i = 0; i < shared.size(); ++i) {
+        const JsonObject s(shared[i], o.file(), o.path_of("shared") + "[" + std::to_string(i) + "]");
+        s.allow_only({"face_a", "edge_a", "face_b", "edge_b"});
+        SharedEdge e;
+        e.face_a = int(s.unsigned_integer_or("face_a", 1u << 30));
+        e.edge_a = int(s.unsigned_integer_or("edge_a", 1u << 30));
+        e.face_b = int(s.unsigned_integer_or("face_b", 1u << 30));
+        e.edge_b = int(s.unsigned_integer_or("edge_b", 1u << 30));
+        spec.assembly.shared.push_back(e);
+      }
+    }
+  }
+  try {
+    validate(spec.assembly);
+  } catch (const InvalidInput& e) {
+    o.fail(o.has("shared") ? "shared" : "", e.what());
+  }
+  const uint64_t level = o.unsigned_integer_or("level", 3);
+  if (level > 8) o.fail("level", "expected a level from 0 to 8");
+  spec.level = int(level);
+  spec.thickness_mm = o.positive_length_or("thickness_mm", 1.0);
+  spec.origin_mm = o.vec3_or("origin_mm", Vec3d{});
+  spec.options.defaults.gap_fraction = fraction(o, "gap_fraction", spec.options.defaults.gap_fraction);
+  spec.options.defaults.lacuna_scale = fraction(o, "lacuna_scale", spec.options.defaults.lacuna_scale);
+  spec.options.defaults.notch_depth = fraction(o, "notch_depth", spec.options.defaults.notch_depth);
+  try {
+    spec.rules = build_rules(spec.assembly.faces);
+  } catch (const InvalidInput& e) {
+    o.fail("", e.what());
+  } catch (const ResourceLimit& e) {
+    throw ResourceLimit(o.file() + ": " + o.path() + ": " + e.what());
+  }
+  // Leaves grow by the spectral radius per level; refuse before building millions.
+  double leaves = 0;
+  for (int root : spec.rules.roots) leaves += lacunarity(spec.rules, root, spec.level).subfaces.back();
+  if (leaves > kMaxLeaves)
+    throw ResourceLimit(o.file() + ": " + o.path_of("level") + ": level " + std::to_string(spec.level) + " has " +
+                        std::to_string(int64_t(leaves)) + " sub-faces, more than 2 000 000; use a lower level");
+  // The shared edges must have the same end points (reversed) on both sides.
+  try {
+    realize_assembly(spec.rules, spec.assembly, spec.controls, 0, spec.options);
+  } catch (const InvalidInput& e) {
+    o.fail(o.has("faces") ? "faces" : "face", e.what());
+  }
+  return spec;
+}
+
+std::vector<std::vector<Vec2d>> plate_loops(const PlateSpec& spec, int level) {
+  std::vector<std::vector<Vec2d>> polygons;
+  for (const auto& face : realize_assembly(spec.rules, spec.assembly, spec.controls, level, spec.options))
+    for (auto& leaf : face) polygons.push_back(std::move(leaf.polygon));
+  // The union's boundary: leaf edges without their reverse. Chained into loops by following, from each end
+  // point, an unused edge that starts there (in-degree equals out-degree at every vertex, so every chain closes).
+  const auto segments = boundary_segments(polygons);
+  auto key = [](const Vec2d& p) { return std::make_pair(p.x, p.y); };
+  std::multimap<std::pair<double, double>, size_t> starts;
+  for (size_t i = 0; i < segments.size(); ++i) starts.emplace(key(segments[i].first), i);
+  std::vector<char> used(segments.size(), 0);
+  std::vector<std::vector<Vec2d>> loops;
+  for (size_t first = 0; first < segments.size(); ++first) {
+    if (used[first]) continue;
+    std::vector<Vec2d> loop;
+    size_t s = first;
+    for (;;) {
+      used[s] = 1;
+      loop.push_back(segments[s].first);
+      const Vec2d end = segments[s].second;
+      if (end.x == segments[first].first.x && end.y == segments[first].first.y) break;
+      size_t next = segments.size();
+      auto range = starts.equal_range(key(end));
+      for (auto it = range.first; it != range.second; ++it)
+        if (!used[it->second]) {
+          next = it->second;
+          break;
+        }
+      if (next == segments.size()) throw std::logic_error("bcifs: the boundary of the leaves does not close");
+      s = next;
+    }
+    loops.push_back(std::move(loop));
+  }
+  return loops;
+}
+
+void register_recipe_inputs() {
+  register_input_type(
+      {"bcifs_plate",
+       {"face", "faces", "shared", "level", "thickness_mm", "radius_mm", "gap_fraction", "lacuna_scale", "notch_depth",
+        "origin_mm"},
+       [](const JsonObject& o, RecipeInput& in) {
+         const PlateSpec spec = parse_plate(o);
+         Region2 region;
+         region.loops_mm = plate_loops(spec, spec.level);
+         region.height_mm = spec.thickness_mm;
+         region.origin_mm = spec.origin_mm;
+         double area = 0;
+         size_t holes = 0;
+         for (const auto& loop : region.loops_mm) {
+           const double a = signed_area(loop);
+           area += a;
+           holes += a < 0;
+         }
+         nlohmann::json faces = nlohmann::json::array();
+         for (size_t f = 0; f < spec.assembly.faces.size(); ++f) {
+           const int type = spec.rules.roots[f];
+           const Lacunarity l = lacunarity(spec.rules, type, spec.level);
+           faces.push_back({{"type", type}, {"subfaces", l.subfaces.back()}, {"lacunas", l.lacunas.back()},
+                            {"r_limit", l.limit}});
+         }
+         in.report = {{"level", spec.level}, {"face_types", spec.rules.rules.size()}, {"faces", faces},
+                      {"loops", region.loops_mm.size()}, {"holes", holes}, {"area_mm2", area}};
+         in.geometry.regions.push_back(std::move(region));
+       }});
+}
+
+}  // namespace bcifs
+}  // namespace lacuna

@@ -1,0 +1,211 @@
+#include "cli/bcifs_commands.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "bcifs/realize.h"
+#include "bcifs/recipe_input.h"
+#include "bcifs/topology.h"
+#include "errors.h"
+#include "recipe/json_fields.h"
+
+namespace lacuna {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct BcifsArgs {
+  std::string boundary;
+  std::string params = "C2 B2 B2";
+  std::string algorithm = "A1";
+  int delay = 1;
+  std::string recipe;
+  std::string levels = "0..4";
+  std::string out_dir;
+  int mask_px = 31;
+  bool json = false;
+};
+
+int bcifs_rules(const BcifsArgs& a) {
+  bcifs::FaceType face;
+  face.boundary = bcifs::parse_boundary(a.boundary);
+  face.edges = bcifs::parse_edge_set(a.params);
+  face.algorithm = bcifs::parse_algorithm(a.algorithm);
+  face.delay = a.delay;
+  const bcifs::RuleSet rules = bcifs::build_rules(face);
+  const nlohmann::json j = bcifs::rules_json(rules, rules.roots[0]);
+  if (a.json) {
+    std::cout << j.dump(1) << "\n";
+    return kExitOk;
+  }
+  for (const auto& t : j["face_types"]) {
+    std::string boundary, children;
+    for (const auto& e : t["boundary"]) boundary += (boundary.empty() ? "" : " ") + e.get<std::string>();
+    for (const auto& c : t["children"]) children += (children.empty() ? "" : " ") + std::to_string(c.get<int>());
+    std::printf("type %d: <%s> delay %d %s -> %s  (lacunas at level 1: %g)\n", t["id"].get<int>(), boundary.c_str(),
+                t["delay"].get<int>(), t["algorithm"].get<std::string>().c_str(), children.c_str(),
+                t["lacunas_1"].get<double>());
+  }
+  std::printf("root %d: N^L_1 = %g, N^C_1 = %g, R = %.12g (spectral radius %.6g)\n", j["root"].get<int>(),
+              j["lacunas_1"].get<double>(), j["subfaces_1"].get<double>(), j["r_limit"].get<double>(),
+              j["spectral_radius"].get<double>());
+  return kExitOk;
+}
+
+// "A..B" or "B" (meaning 0..B).
+std::pair<int, int> parse_levels(const std::string& text) {
+  int lo = 0, hi = 0;
+  char dots[3] = {0, 0, 0};
+  std::istringstream in(text);
+  if (text.find("..") != std::string::npos) {
+    if (!(in >> lo >> dots[0] >> dots[1] >> hi) || dots[0] != '.' || dots[1] != '.')
+      throw InvalidInput("--levels: expected \"A..B\" such as 0..5, got \"" + text + "\"");
+  } else if (!(in >> hi)) {
+    throw InvalidInput("--levels: expected \"A..B\" such as 0..5, got \"" + text + "\"");
+  }
+  if (lo < 0 || hi < lo || hi > 8) throw InvalidInput("--levels: expected 0 <= A <= B <= 8, got \"" + text + "\"");
+  return {lo, hi};
+}
+
+// Rows bottom-up (the raster) to top-down (PNG).
+std::vector<uint8_t> flip_rows(const std::vector<uint8_t>& rgb, int width, int height) {
+  std::vector<uint8_t> out(rgb.size());
+  const size_t row = size_t(3 * width);
+  for (int y = 0; y < height; ++y)
+    std::copy(rgb.begin() + long(size_t(y) * row), rgb.begin() + long(size_t(y + 1) * row),
+              out.begin() + long(size_t(height - 1 - y) * row));
+  return out;
+}
+
+int bcifs_measure(const BcifsArgs& a) {
+  const auto [lo, hi] = parse_levels(a.levels);
+  std::ifstream file(a.recipe, std::ios::binary);
+  if (!file) throw IoError(a.recipe + ": cannot open the recipe file");
+  std::stringstream text;
+  text << file.rdbuf();
+  const nlohmann::json top = parse_json_text(text.str(), a.recipe);
+  if (!top.is_object() || !top.contains("inputs") || !top["inputs"].is_object())
+    throw InvalidInput(a.recipe + ": expected a recipe with \"inputs\"");
+  const fs::path out_dir = a.out_dir.empty() ? fs::path(fs::path(a.recipe).stem().string() + "_measures") : fs::path(a.out_dir);
+  nlohmann::json result = nlohmann::json::object();
+  std::vector<std::pair<std::string, std::vector<uint8_t>>> images;  // written only once everything worked
+  for (const auto& [name, value] : top["inputs"].items()) {
+    if (!value.is_object() || value.value("type", "") != "bcifs_plate") continue;
+    nlohmann::json object = value;
+    object.erase("type");
+    const bcifs::PlateSpec spec = bcifs::parse_plate(JsonObject(object, a.recipe, "inputs." + name));
+    nlohmann::json entry;
+    nlohmann::json faces = nlohmann::json::array();
+    for (size_t f = 0; f < spec.assembly.faces.size(); ++f) {
+      const bcifs::Lacunarity l = bcifs::lacunarity(spec.rules, spec.rules.roots[f], hi);
+      faces.push_back({{"type", spec.rules.roots[f]}, {"subfaces", l.subfaces}, {"lacunas", l.lacunas},
+                       {"ratio", l.ratio}, {"r_limit", l.limit}, {"spectral_radius", l.spectral_radius}});
+    }
+    entry["topology"] = faces;
+    bcifs::GeometricMeasures m;
+    std::vector<std::vector<Vec2d>> top_polygons;
+    for (int level = lo; level <= hi; ++level) {
+      std::vector<std::vector<Vec2d>> polygons;
+      for (const auto& face : bcifs::realize_assembly(spec.rules, spec.assembly, spec.controls, level, spec.options))
+        for (const bcifs::Leaf& leaf : face) polygons.push_back(leaf.polygon);
+      double area = 0;
+      for (const auto& p : polygons) area += bcifs::signed_area(p);
+      m.area.push_back(area);
+      m.perimeter.push_back(bcifs::union_perimeter(polygons));
+      if (level == hi) top_polygons = std::move(polygons);
+    }
+    const double steps = double(hi - lo);
+    m.area_factor = steps > 0 ? std::pow(m.area.back() / m.area.front(), 1 / steps) : 1.0;
+    m.perimeter_factor = steps > 0 ? std::pow(m.perimeter.back() / m.perimeter.front(), 1 / steps) : 1.0;
+    const bcifs::BoxCount region = bcifs::box_count_region(top_polygons);
+    const bcifs::BoxCount boundary = bcifs::box_count_segments(bcifs::boundary_segments(top_polygons));
+    entry["levels"] = {lo, hi};
+    entry["area_mm2"] = m.area;
+    entry["perimeter_mm"] = m.perimeter;
+    entry["F_A"] = m.area_factor;
+    entry["F_P"] = m.perimeter_factor;
+    entry["box_counting"] = {{"region_dimension", region.dimension},
+                             {"boundary_dimension", boundary.dimension},
+                             {"log_inverse_size", boundary.log_inverse_size},
+                             {"boundary_log_count", boundary.log_count},
+                             {"region_log_count", region.log_count}};
+    bcifs::Raster raster = bcifs::square_raster(top_polygons, 1024);
+    bcifs::rasterize(top_polygons, raster);
+    const std::vector<uint8_t> mask = bcifs::mask_of(raster);
+    const auto density = bcifs::density_colours(bcifs::density_map(mask, 1024, 1024, a.mask_px));
+    const std::string density_file = (out_dir / (name + "_density.png")).string();
+    const std::string plot_file = (out_dir / (name + "_plot.png")).string();
+    images.push_back({density_file, bcifs::encode_png(1024, 1024, flip_rows(density, 1024, 1024))});
+    images.push_back({plot_file, bcifs::encode_png(800, 400, bcifs::plot_measures(m, boundary, 800, 400))});
+    entry["density_map"] = density_file;
+    entry["mask_px"] = a.mask_px;
+    entry["plot"] = plot_file;
+    result[name] = entry;
+  }
+  if (result.empty()) throw InvalidInput(a.recipe + ": inputs: no input of type \"bcifs_plate\" to measure");
+  fs::create_directories(out_dir);
+  for (const auto& [path, bytes] : images) {
+    const std::string temp = path + ".part";
+    std::ofstream out(temp, std::ios::binary);
+    out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    out.close();
+    if (!out) {
+      std::remove(temp.c_str());
+      throw IoError(path + ": cannot write");
+    }
+    fs::rename(temp, path);
+  }
+  if (a.json) {
+    std::cout << result.dump(1) << "\n";
+    return kExitOk;
+  }
+  for (const auto& [name, e] : result.items()) {
+    std::printf("%s:\n", name.c_str());
+    for (size_t i = 0; i < e["area_mm2"].size(); ++i)
+      std::printf("  level %d: area %.6g mm2, perimeter %.6g mm\n", lo + int(i), e["area_mm2"][i].get<double>(),
+                  e["perimeter_mm"][i].get<double>());
+    std::printf("  F_A %.6g, F_P %.6g, box-counting dimension %.4g (region), %.4g (boundary)\n", e["F_A"].get<double>(),
+                e["F_P"].get<double>(), e["box_counting"]["region_dimension"].get<double>(),
+                e["box_counting"]["boundary_dimension"].get<double>());
+    for (const auto& f : e["topology"])
+      std::printf("  face type %d: N^C %g, N^L %g, R_%d %.6g, R %.9g\n", f["type"].get<int>(),
+                  f["subfaces"].back().get<double>(), f["lacunas"].back().get<double>(), hi, f["ratio"].back().get<double>(),
+                  f["r_limit"].get<double>());
+    std::printf("  wrote %s and %s\n", e["density_map"].get<std::string>().c_str(), e["plot"].get<std::string>().c_str());
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+std::function<int()> add_bcifs_commands(CLI::App& app) {
+  auto args = std::make_shared<BcifsArgs>();
+  CLI::App* bcifs = app.add_subcommand("bcifs", "Lacunar faces (boundary-controlled IFS): rule sets and measures");
+  bcifs->require_subcommand(1);
+  CLI::App* rules = bcifs->add_subcommand("rules", "The rule set of a face: face types, sub-faces, N^L_1, N^C_1, R");
+  rules->add_option("--boundary", args->boundary, "Edge types counter-clockwise, e.g. \"C4 B2 C2 B2 C3 B2\"")->required();
+  rules->add_option("--params", args->params, "E = \"Ea El Ec\" (default \"C2 B2 B2\")");
+  rules->add_option("--algorithm", args->algorithm, "A1 (default), A2 or A3");
+  rules->add_option("--delay", args->delay, "Delay of the face (1: none)")->check(CLI::Range(1, 16));
+  rules->add_flag("--json", args->json, "Print JSON");
+  CLI::App* measure = bcifs->add_subcommand(
+      "measure", "Topological and geometric measures of the bcifs_plate inputs of a recipe, with density maps and plots");
+  measure->add_option("recipe", args->recipe, "Recipe file")->required();
+  measure->add_option("--levels", args->levels, "Levels A..B (default 0..4)");
+  measure->add_option("-o,--output", args->out_dir, "Folder for the PNG files (default: <recipe>_measures)");
+  measure->add_option("--mask-px", args->mask_px, "Side of the density mask in pixels (of 1024)")->check(CLI::Range(1, 1023));
+  measure->add_flag("--json", args->json, "Print JSON");
+  return [=]() -> int {
+    if (*rules) return bcifs_rules(*args);
+    if (*measure) return bcifs_measure(*args);
+    return -1;
+  };
+}
+
+}  // namespace lacuna
