@@ -137,12 +137,3 @@ int run_bench(int argc, char** argv) {
   std::printf("%s\n", result.dump().c_str());
   return 0;
 }
-
-int main(int argc, char** argv) {
-  try {
-    return run_bench(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "lacuna_fill_bench: %s\n", e.what());
-    return 1;
-  }
-}

@@ -77,12 +77,3 @@ int run_bench(int argc, char** argv) {
   std::cout << result.dump(1) << "\n";
   return 0;
 }
-
-int main(int argc, char** argv) {
-  try {
-    return run_bench(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "lacuna_voronoi_bench: %s\n", e.what());
-    return 1;
-  }
-}

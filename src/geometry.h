@@ -45,6 +45,12 @@ struct Vec2d {
   constexpr bool operator==(const Vec2d& o) const { return x == o.x && y == o.y; }
 };
 
+inline double cross2(const Vec2d& a, const Vec2d& b) { return a.x * b.y - a.y * b.x; }
+// Shoelace area of a closed polygon (the last point is not repeated): positive when counter-clockwise.
+double signed_area(const std::vector<Vec2d>& polygon);
+// Whether the closed segments ab and cd share a point (exact orientation signs of the double inputs).
+bool segments_intersect(const Vec2d& a, const Vec2d& b, const Vec2d& c, const Vec2d& d);
+
 // An axis-aligned box; empty when min > max on any axis.
 struct Box3 {
   Vec3d min{HUGE_VAL, HUGE_VAL, HUGE_VAL};

@@ -20,7 +20,6 @@ using curves::CurveKind;
 using curves::Polyline2;
 using curves::Polyline3;
 
-double cross2(const Vec2d& a, const Vec2d& b) { return a.x * b.y - a.y * b.x; }
 double length2(const Vec2d& v) { return std::hypot(v.x, v.y); }
 size_t segment_count(const Polyline2& p) {
   return p.points.empty() ? 0 : (p.closed ? p.points.size() : p.points.size() - 1);

@@ -22,7 +22,6 @@ using fill::Placement2;
 
 constexpr double kPi = 3.14159265358979323846;
 
-double cross2(const Vec2d& a, const Vec2d& b) { return a.x * b.y - a.y * b.x; }
 double dot2(const Vec2d& a, const Vec2d& b) { return a.x * b.x + a.y * b.y; }
 double len(const Vec2d& v) { return std::hypot(v.x, v.y); }
 

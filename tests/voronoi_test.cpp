@@ -417,6 +417,17 @@ double piece_area_2d(const voronoi::ConvexPiece& piece) {
   return a / 2;
 }
 
+// The spec's 2D example and four random 3D points, each with the (highest) level to test it at.
+struct StartingSet {
+  int n;
+  std::vector<std::vector<double>> points;
+  int level;
+};
+
+std::vector<StartingSet> starting_sets(int level_2d, int level_3d) {
+  return {{2, kExample, level_2d}, {3, voronoi::random_points(3, 4, 11), level_3d}};
+}
+
 TEST(VoronoiWalls, ClosedForms) {
   // Two generators on a line: the walls are the two bisectors x = 1/2 and x = 0 (= 1), each of measure 1.
   for (int n : {2, 3}) {
@@ -440,15 +451,9 @@ TEST(VoronoiWalls, ClosedForms) {
 
 // The m-cell-shapes method against every generator's own clipped cell.
 TEST(VoronoiWalls, ShapeMethodMatchesClipping) {
-  struct Case {
-    int n;
-    std::vector<std::vector<double>> points;
-    int max_level;
-  };
-  const std::vector<Case> cases = {{2, kExample, 4}, {3, voronoi::random_points(3, 4, 11), 2}};
-  for (const Case& c : cases) {
+  for (const StartingSet& c : starting_sets(4, 2)) {
     const Rules rules = voronoi::make_rules(c.n, 2, c.points, scaled());
-    for (int k = 0; k <= c.max_level; ++k) {
+    for (int k = 0; k <= c.level; ++k) {
       const Level level = voronoi::generate_level(rules, k);
       const voronoi::Walls fast = voronoi::extract_walls(rules, level);
       const voronoi::Walls reference = voronoi::walls_by_clipping(level);
@@ -476,13 +481,7 @@ TEST(VoronoiWalls, ShapeMethodMatchesClipping) {
 // domain of the torus (measure 1); with a gap, tiles + gap (wall measure x width) still make 1 up to the
 // corners where walls meet.
 TEST(VoronoiTiles, PiecesPartitionAFundamentalDomain) {
-  struct Case {
-    int n;
-    std::vector<std::vector<double>> points;
-    int level;
-  };
-  const std::vector<Case> cases = {{2, kExample, 3}, {3, voronoi::random_points(3, 4, 11), 2}};
-  for (const Case& c : cases) {
+  for (const StartingSet& c : starting_sets(3, 2)) {
     const Rules rules = voronoi::make_rules(c.n, 2, c.points, scaled());
     const Level level = voronoi::generate_level(rules, c.level, true);
     const std::vector<double> measures =

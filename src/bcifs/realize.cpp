@@ -84,25 +84,6 @@ std::vector<Vec2d> canonical_polygon(const SubFace& sub, const std::vector<Vec2d
   return out;
 }
 
-double cross(const Vec2d& a, const Vec2d& b, const Vec2d& c) {
-  return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
-}
-
-bool on_segment(const Vec2d& a, const Vec2d& b, const Vec2d& p) {
-  return std::min(a.x, b.x) <= p.x && p.x <= std::max(a.x, b.x) && std::min(a.y, b.y) <= p.y &&
-         p.y <= std::max(a.y, b.y);
-}
-
-bool segments_meet(const Vec2d& a, const Vec2d& b, const Vec2d& c, const Vec2d& d) {
-  const double d1 = cross(c, d, a), d2 = cross(c, d, b), d3 = cross(a, b, c), d4 = cross(a, b, d);
-  if (((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0))) return true;
-  if (d1 == 0 && on_segment(c, d, a)) return true;
-  if (d2 == 0 && on_segment(c, d, b)) return true;
-  if (d3 == 0 && on_segment(a, b, c)) return true;
-  if (d4 == 0 && on_segment(a, b, d)) return true;
-  return false;
-}
-
 using EdgeKey = std::array<double, 4>;
 
 BoxCount fit(const std::vector<uint8_t>& mask, int size) {
@@ -317,16 +298,6 @@ std::vector<std::pair<Vec2d, Vec2d>> edge_segments(const RuleSet& rules, int typ
   return out;
 }
 
-double signed_area(const std::vector<Vec2d>& polygon) {
-  double twice = 0;
-  for (size_t i = 0; i < polygon.size(); ++i) {
-    const Vec2d& a = polygon[i];
-    const Vec2d& b = polygon[(i + 1) % polygon.size()];
-    twice += a.x * b.y - b.x * a.y;
-  }
-  return 0.5 * twice;
-}
-
 bool is_simple(const std::vector<Vec2d>& polygon) {
   const size_t n = polygon.size();
   if (n < 3) return false;
@@ -343,11 +314,11 @@ bool is_simple(const std::vector<Vec2d>& polygon) {
         const Vec2d& shared = j == i + 1 ? b : a;
         const Vec2d& p = j == i + 1 ? a : b;
         const Vec2d& q = j == i + 1 ? d : c;
-        if (cross(shared, p, q) == 0 && (p.x - shared.x) * (q.x - shared.x) + (p.y - shared.y) * (q.y - shared.y) > 0)
+        if (cross2(p - shared, q - shared) == 0 && (p.x - shared.x) * (q.x - shared.x) + (p.y - shared.y) * (q.y - shared.y) > 0)
           return false;
         continue;
       }
-      if (segments_meet(a, b, c, d)) return false;
+      if (segments_intersect(a, b, c, d)) return false;
     }
   }
   return true;
@@ -386,9 +357,16 @@ std::vector<std::vector<Vec2d>> polygons_of(const std::vector<Leaf>& leaves) {
 
 GeometricMeasures geometric_measures(const RuleSet& rules, int type, const std::vector<Vec2d>& control, int levels,
                                      const RealizeOptions& options) {
+  return geometric_measures(rules, std::vector<Leaf>{Leaf{control, type}}, 0, levels, options);
+}
+
+GeometricMeasures geometric_measures(const RuleSet& rules, std::vector<Leaf> leaves, int first, int last,
+                                     const RealizeOptions& options, std::vector<std::vector<Vec2d>>* last_polygons) {
+  if (first < 0 || last < first)
+    throw InvalidInput("geometric_measures: expected 0 <= first <= last, got " + std::to_string(first) + ".." +
+                       std::to_string(last));
   GeometricMeasures out;
-  std::vector<Leaf> leaves{Leaf{control, type}};
-  for (int level = 0; level <= levels; ++level) {
+  for (int level = 0; level <= last; ++level) {
     if (level > 0) {
       std::vector<Leaf> next;
       for (const Leaf& leaf : leaves) {
@@ -397,15 +375,17 @@ GeometricMeasures geometric_measures(const RuleSet& rules, int type, const std::
       }
       leaves.swap(next);
     }
+    if (level < first) continue;
     double area = 0;
     for (const Leaf& leaf : leaves) area += signed_area(leaf.polygon);
     out.area.push_back(area);
     out.perimeter.push_back(union_perimeter(polygons_of(leaves)));
   }
-  if (levels > 0) {
-    out.area_factor = std::pow(out.area.back() / out.area.front(), 1.0 / levels);
-    out.perimeter_factor = std::pow(out.perimeter.back() / out.perimeter.front(), 1.0 / levels);
+  if (last > first) {
+    out.area_factor = std::pow(out.area.back() / out.area.front(), 1.0 / (last - first));
+    out.perimeter_factor = std::pow(out.perimeter.back() / out.perimeter.front(), 1.0 / (last - first));
   }
+  if (last_polygons) *last_polygons = polygons_of(leaves);
   return out;
 }
 

@@ -83,7 +83,6 @@ std::vector<std::vector<Leaf>> realize_assembly(const RuleSet& rules, const Asse
 std::vector<std::pair<Vec2d, Vec2d>> edge_segments(const RuleSet& rules, int type, const std::vector<Vec2d>& control,
                                                    int edge, int levels, const RealizeOptions& options = {});
 
-double signed_area(const std::vector<Vec2d>& polygon);  // positive when counter-clockwise
 // No two edges meet except consecutive ones at their common vertex, and no edge has zero length.
 bool is_simple(const std::vector<Vec2d>& polygon);
 
@@ -101,6 +100,13 @@ struct GeometricMeasures {
 
 GeometricMeasures geometric_measures(const RuleSet& rules, int type, const std::vector<Vec2d>& control, int levels,
                                      const RealizeOptions& options = {});
+
+// The same from any level-0 leaves (the faces of an assembly, say), measured at levels first..last (A_0, P_0
+// above then stand for level `first`; the factors span last - first levels). `last_polygons`, when given,
+// receives the leaves of level `last`. Throws InvalidInput unless 0 <= first <= last.
+GeometricMeasures geometric_measures(const RuleSet& rules, std::vector<Leaf> leaves, int first, int last,
+                                     const RealizeOptions& options = {},
+                                     std::vector<std::vector<Vec2d>>* last_polygons = nullptr);
 
 // A pixel grid over the plane: pixel (x, y) has its centre at origin + ((x + 0.5) p, (y + 0.5) p), row y = 0 at
 // the bottom.

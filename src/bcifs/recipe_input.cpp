@@ -1,5 +1,6 @@
 #include "bcifs/recipe_input.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <string>
@@ -59,13 +60,7 @@ std::vector<Vec2d> parse_control(const JsonObject& f, size_t edges, double radiu
   if (control.size() != edges)
     f.fail("control_mm", "expected " + std::to_string(edges) + " points (one per boundary edge), got " +
                              std::to_string(control.size()));
-  double area = 0;
-  for (size_t j = 0; j < edges; ++j) {
-    const Vec2d& p = control[j];
-    const Vec2d& q = control[(j + 1) % edges];
-    area += p.x * q.y - p.y * q.x;
-  }
-  if (!(area > 0)) f.fail("control_mm", "expected a counter-clockwise polygon of positive area");
+  if (!(signed_area(control) > 0)) f.fail("control_mm", "expected a counter-clockwise polygon of positive area");
   return control;
 }
 
@@ -100,11 +95,15 @@ PlateSpec parse_plate(const JsonObject& o) {
       for (size_t i = 0; i < shared.size(); ++i) {
         const JsonObject s(shared[i], o.file(), o.path_of("shared") + "[" + std::to_string(i) + "]");
         s.allow_only({"face_a", "edge_a", "face_b", "edge_b"});
+        auto index = [&](const char* key) {
+          if (!s.has(key)) s.fail(key, "expected a 0-based index");
+          return int(std::min<uint64_t>(s.unsigned_integer_or(key, 0), 1u << 30));
+        };
         SharedEdge e;
-        e.face_a = int(s.unsigned_integer_or("face_a", 1u << 30));
-        e.edge_a = int(s.unsigned_integer_or("edge_a", 1u << 30));
-        e.face_b = int(s.unsigned_integer_or("face_b", 1u << 30));
-        e.edge_b = int(s.unsigned_integer_or("edge_b", 1u << 30));
+        e.face_a = index("face_a");
+        e.edge_a = index("edge_a");
+        e.face_b = index("face_b");
+        e.edge_b = index("edge_b");
         spec.assembly.shared.push_back(e);
       }
     }

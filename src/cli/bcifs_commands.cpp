@@ -108,21 +108,12 @@ int bcifs_measure(const BcifsArgs& a) {
                        {"ratio", l.ratio}, {"r_limit", l.limit}, {"spectral_radius", l.spectral_radius}});
     }
     entry["topology"] = faces;
-    bcifs::GeometricMeasures m;
+    std::vector<bcifs::Leaf> faces_at_level_0;
+    for (auto& face : bcifs::realize_assembly(spec.rules, spec.assembly, spec.controls, 0, spec.options))
+      faces_at_level_0.insert(faces_at_level_0.end(), face.begin(), face.end());
     std::vector<std::vector<Vec2d>> top_polygons;
-    for (int level = lo; level <= hi; ++level) {
-      std::vector<std::vector<Vec2d>> polygons;
-      for (const auto& face : bcifs::realize_assembly(spec.rules, spec.assembly, spec.controls, level, spec.options))
-        for (const bcifs::Leaf& leaf : face) polygons.push_back(leaf.polygon);
-      double area = 0;
-      for (const auto& p : polygons) area += bcifs::signed_area(p);
-      m.area.push_back(area);
-      m.perimeter.push_back(bcifs::union_perimeter(polygons));
-      if (level == hi) top_polygons = std::move(polygons);
-    }
-    const double steps = double(hi - lo);
-    m.area_factor = steps > 0 ? std::pow(m.area.back() / m.area.front(), 1 / steps) : 1.0;
-    m.perimeter_factor = steps > 0 ? std::pow(m.perimeter.back() / m.perimeter.front(), 1 / steps) : 1.0;
+    const bcifs::GeometricMeasures m =
+        bcifs::geometric_measures(spec.rules, faces_at_level_0, lo, hi, spec.options, &top_polygons);
     const bcifs::BoxCount region = bcifs::box_count_region(top_polygons);
     const bcifs::BoxCount boundary = bcifs::box_count_segments(bcifs::boundary_segments(top_polygons));
     entry["levels"] = {lo, hi};

@@ -68,8 +68,6 @@ constexpr Pattern kSierpinskiPatterns[4] = {
     {{kD, kA, kC, kD}, {{1, 1}, {0, 2}, {-1, 1}}},
 };
 
-double cross2(const Vec2d& a, const Vec2d& b) { return a.x * b.y - a.y * b.x; }
-
 Vec3d normalized(const Vec3d& v) {
   const double n = norm(v);
   return n > 0 ? v / n : Vec3d{};
@@ -228,12 +226,6 @@ std::vector<Vec2d> clip_to_box(const std::vector<Vec2d>& polygon, const Box2& bo
   return in;
 }
 
-double polygon_area(const std::vector<Vec2d>& p) {
-  double a = 0;
-  for (size_t i = 0; i < p.size(); ++i) a += cross2(p[i], p[(i + 1) % p.size()]);
-  return 0.5 * std::fabs(a);
-}
-
 // Whether the convex polygon (orientation `sign`: +1 counter-clockwise) contains point c, border included.
 bool contains(const std::vector<Vec2d>& p, double sign, const Vec2d& c) {
   for (size_t i = 0; i < p.size(); ++i) {
@@ -251,7 +243,7 @@ Box2 bounds(const std::vector<Vec2d>& p) {
 
 // The union area of convex polygons that all lie inside [x0, x1] in x (clipped to one cell).
 double union_area_in_cell(const std::vector<std::vector<Vec2d>>& polys, double x0, double x1) {
-  if (polys.size() == 1) return polygon_area(polys[0]);
+  if (polys.size() == 1) return std::fabs(signed_area(polys[0]));
   std::vector<Box2> box;
   for (const auto& p : polys) box.push_back(bounds(p));
   std::vector<double> xs{x0, x1};
@@ -330,8 +322,7 @@ double convex_union_area(const std::vector<std::vector<Vec2d>>& polygons, const 
     if (p.size() < 3) continue;
     const Box2 b = bounds(p);
     if (b.x1 <= clip_min.x || b.x0 >= clip_max.x || b.y1 <= clip_min.y || b.y0 >= clip_max.y) continue;
-    double a = 0;
-    for (size_t j = 0; j < p.size(); ++j) a += cross2(p[j], p[(j + 1) % p.size()]);
+    const double a = signed_area(p);
     if (a == 0) continue;
     kept.push_back(i);
     box.push_back(b);

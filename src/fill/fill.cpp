@@ -44,11 +44,6 @@ void check_finite(const std::vector<Vec2d>& points, const char* what) {
     if (!std::isfinite(p.x) || !std::isfinite(p.y)) throw InvalidInput(std::string(what) + " has a non-finite point");
 }
 
-double signed_area(const std::vector<Vec2d>& p) {
-  double a = 0;
-  for (size_t i = 0, n = p.size(); i < n; ++i) a += detail::cross2(p[i], p[(i + 1) % n]);
-  return a / 2;
-}
 
 // Drops repeated points and points on the straight line through their neighbours (not spikes, which the
 // simplicity test rejects), makes the polygon counter-clockwise and checks that it is simple.
@@ -66,7 +61,7 @@ std::vector<Vec2d> clean_simple_polygon(const std::vector<Vec2d>& points, const 
     for (size_t i = 0; i < p.size() && p.size() >= 3; ++i) {
       const Vec2d a = p[(i + p.size() - 1) % p.size()], b = p[i], c = p[(i + 1) % p.size()];
       const Vec2d u = b - a, v = c - b;
-      if (std::fabs(detail::cross2(u, v)) <= 1e-12 * detail::length2(u) * detail::length2(v) &&
+      if (std::fabs(cross2(u, v)) <= 1e-12 * detail::length2(u) * detail::length2(v) &&
           detail::dot2(u, v) > 0) {
         p.erase(p.begin() + long(i));
         changed = true;
@@ -85,12 +80,12 @@ std::vector<Vec2d> clean_simple_polygon(const std::vector<Vec2d>& points, const 
         // Adjacent edges share a vertex; they overlap only when the outline doubles back.
         const size_t shared = j == i + 1 ? j : i;
         const Vec2d prev = p[(shared + n - 1) % n], next = p[(shared + 1) % n], s = p[shared];
-        if (std::fabs(detail::cross2(s - prev, next - s)) <= 1e-12 * detail::length2(s - prev) * detail::length2(next - s) &&
+        if (std::fabs(cross2(s - prev, next - s)) <= 1e-12 * detail::length2(s - prev) * detail::length2(next - s) &&
             detail::dot2(s - prev, next - s) < 0)
           throw InvalidInput(std::string(what) + " doubles back on itself at point " + std::to_string(shared));
         continue;
       }
-      if (detail::segments_intersect(p[i], p[(i + 1) % n], p[j], p[(j + 1) % n]))
+      if (segments_intersect(p[i], p[(i + 1) % n], p[j], p[(j + 1) % n]))
         throw InvalidInput(std::string(what) + " is not simple: edges " + std::to_string(i) + " and " +
                            std::to_string(j) + " meet");
     }
@@ -101,7 +96,7 @@ Vec2d centroid(const std::vector<Vec2d>& p) {
   double a = 0, x = 0, y = 0;
   for (size_t i = 0, n = p.size(); i < n; ++i) {
     const Vec2d u = p[i], v = p[(i + 1) % n];
-    const double w = detail::cross2(u, v);
+    const double w = cross2(u, v);
     a += w;
     x += (u.x + v.x) * w;
     y += (u.y + v.y) * w;
@@ -237,21 +232,6 @@ double point_segment_distance(const Vec2d& p, const Vec2d& a, const Vec2d& b) {
   return length2(ap - ab * t);
 }
 
-bool segments_intersect(const Vec2d& a, const Vec2d& b, const Vec2d& c, const Vec2d& d) {
-  auto orient = [](const Vec2d& p, const Vec2d& q, const Vec2d& r) {
-    const double v = cross2(q - p, r - p);
-    return (v > 0) - (v < 0);
-  };
-  auto on = [](const Vec2d& p, const Vec2d& q, const Vec2d& r) {  // r on segment pq, given collinear
-    return std::min(p.x, q.x) <= r.x && r.x <= std::max(p.x, q.x) && std::min(p.y, q.y) <= r.y &&
-           r.y <= std::max(p.y, q.y);
-  };
-  const int o1 = orient(a, b, c), o2 = orient(a, b, d), o3 = orient(c, d, a), o4 = orient(c, d, b);
-  if (o1 != o2 && o3 != o4) return true;
-  return (o1 == 0 && on(a, b, c)) || (o2 == 0 && on(a, b, d)) || (o3 == 0 && on(c, d, a)) ||
-         (o4 == 0 && on(c, d, b));
-}
-
 double outline_distance(const std::vector<Vec2d>& poly, const Vec2d& p) {
   double d = HUGE_VAL;
   for (size_t i = 0, n = poly.size(); i < n; ++i) d = std::min(d, point_segment_distance(p, poly[i], poly[(i + 1) % n]));
@@ -375,7 +355,7 @@ Motif2 polygon_motif(const std::vector<Vec2d>& points) {
   m.outline = p;
   m.convex = true;
   for (size_t i = 0, n = p.size(); i < n; ++i)
-    if (detail::cross2(p[(i + 1) % n] - p[i], p[(i + 2) % n] - p[(i + 1) % n]) < 0) m.convex = false;
+    if (cross2(p[(i + 1) % n] - p[i], p[(i + 2) % n] - p[(i + 1) % n]) < 0) m.convex = false;
   m.interior_point = interior_point(p);
   detect_symmetry(m);
   return m;

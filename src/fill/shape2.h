@@ -18,7 +18,6 @@ namespace lacuna {
 namespace fill {
 namespace detail {
 
-inline double cross2(const Vec2d& a, const Vec2d& b) { return a.x * b.y - a.y * b.x; }
 inline double dot2(const Vec2d& a, const Vec2d& b) { return a.x * b.x + a.y * b.y; }
 inline double length2(const Vec2d& v) { return std::hypot(v.x, v.y); }
 
@@ -38,8 +37,6 @@ Shape2 place(const Motif2& motif, const Placement2& placement);
 // Crossing-number test (either orientation); points on the outline go either way.
 bool point_in_polygon(const std::vector<Vec2d>& polygon, const Vec2d& p);
 double point_segment_distance(const Vec2d& p, const Vec2d& a, const Vec2d& b);
-// Whether the closed segments ab and cd share a point.
-bool segments_intersect(const Vec2d& a, const Vec2d& b, const Vec2d& c, const Vec2d& d);
 // The distance from p to the outline of the polygon.
 double outline_distance(const std::vector<Vec2d>& polygon, const Vec2d& p);
 // Whether some edge of one polygon meets some edge of the other.

@@ -14,7 +14,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-using detail::cross2;
 using detail::dot2;
 using detail::length2;
 
@@ -105,12 +104,6 @@ Affine2 shifted(const Affine2& m, const Vec2d& t) {
 }
 
 double det(const Affine2& m) { return m.linear[0][0] * m.linear[1][1] - m.linear[0][1] * m.linear[1][0]; }
-
-double polygon_area(const std::vector<Vec2d>& p) {
-  double s = 0;
-  for (size_t i = 0, n = p.size(); i < n; ++i) s += cross2(p[i], p[(i + 1) % n]);
-  return s / 2;
-}
 
 // An element g(x) = L x + t of the group acting on the plane (one operation plus a lattice translation).
 struct Element {
@@ -350,7 +343,7 @@ std::vector<Vec2d> fundamental_region_mm(Group group, const Lattice& lattice) {
   const Frame f = frame_of(group_lattice(group, lattice));
   std::vector<Vec2d> out;
   for (const Vec2d& p : fundamental_region(group)) out.push_back(f.to_world(p));
-  if (polygon_area(out) < 0) std::reverse(out.begin(), out.end());
+  if (signed_area(out) < 0) std::reverse(out.begin(), out.end());
   return out;
 }
 
@@ -386,7 +379,7 @@ WallpaperFill fill_wallpaper(Group group, const Lattice& lattice, const Motif2& 
 
   const std::vector<Vec2d> cell_region = fundamental_region(group);
   const std::vector<Vec2d> region = fundamental_region_mm(group, out.lattice);
-  const double A = std::fabs(polygon_area(region));
+  const double A = std::fabs(signed_area(region));
   Vec2d lo{HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL}, mid;
   for (const Vec2d& p : cell_region) lo = {std::min(lo.x, p.x), std::min(lo.y, p.y)}, hi = {std::max(hi.x, p.x), std::max(hi.y, p.y)};
   for (const Vec2d& p : region) mid = mid + p * (1.0 / double(region.size()));

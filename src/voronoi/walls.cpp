@@ -84,15 +84,7 @@ Lattice make_lattice(const Rules& rules, const Level& level) {
 }
 
 // The periodic cells of the starting points (level 0), each face with its neighbour and shift.
-std::vector<Cell> shape_cells(const Rules& rules) {
-  Level zero;
-  zero.dimension = rules.dimension;
-  zero.colour_count = int(rules.points.size());
-  zero.points = rules.points;
-  for (size_t i = 0; i < rules.points.size(); ++i) zero.colours.push_back(int(i));
-  zero.shapes = zero.colours;
-  return periodic_cells(zero);
-}
+std::vector<Cell> shape_cells(const Rules& rules) { return periodic_cells(generate_level(rules, 0)); }
 
 }  // namespace
 
