@@ -380,6 +380,8 @@ std::vector<BadCase> bad_cases() {
   const std::string mesh_input = R"({"type": "mesh", "file": "hull.stl"})";
   return {
       {"empty_file", "", "", "", "JSON"},
+      {"bcifs_cell_kind", R"({"inputs": {"c": {"type": "bcifs_cell", "cell": "dodecahedron", "edge_mm": 10,
+          "thickness_mm": 1}}, "outputs": [{"of": "c", "file": "c.stl"}]})", "", "", "truncated_tetrahedron"},
       {"bcifs_bad_edge", R"({"inputs": {"p": {"type": "bcifs_plate", "face": {"boundary": "C2 Q2 C2"}, "radius_mm": 5}},
           "outputs": [{"of": "p", "file": "p.stl"}]})", "", "", "inputs.p.face.boundary"},
       {"bcifs_control_count", R"({"inputs": {"p": {"type": "bcifs_plate", "face": {"boundary": "C2 B2 C2",
@@ -670,6 +672,32 @@ TEST(Cli, BcifsRulesPlateAndMeasure) {
   EXPECT_TRUE(fs::exists(dir / "m" / "plate_density.png"));
   EXPECT_TRUE(fs::exists(dir / "m" / "plate_plot.png"));
   EXPECT_EQ(read_file(dir / "m" / "plate_plot.png").substr(1, 3), "PNG");
+}
+
+// A lacunar cube: at level 0 its faces are whole, and the cell is the cube shell s^3 - (s - 2t)^3 (two
+// components: the cavity is sealed); at level 1 every face has its lacuna and every C2 edge one gap, where the
+// notches of both faces open the edge: a sphere with 6 + 12 openings, thickened, has genus 17.
+TEST(Cli, BcifsCellShellAndOpenings) {
+  TempDir dir;
+  write_file(dir / "cell.json", R"({"voxel_size_mm": 0.08, "inputs": {
+      "c0": {"type": "bcifs_cell", "cell": "hexahedron", "edge_mm": 10, "level": 0, "thickness_mm": 1},
+      "c1": {"type": "bcifs_cell", "cell": "hexahedron", "edge_mm": 12, "level": 1, "thickness_mm": 0.8,
+             "center_mm": [30, 0, 0]}},
+      "outputs": [{"of": "c0", "file": "c0.stl"}, {"of": "c1", "file": "c1.stl"}]})");
+  Result r = lacuna("run " + quote((dir / "cell.json").string()) + " -o " + quote((dir / "out").string()) + " --json",
+                    dir.path());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json outputs = nlohmann::json::parse(r.out)["outputs"];
+  ASSERT_EQ(outputs.size(), 2u);
+  EXPECT_TRUE(outputs[0]["checks"]["valid"].get<bool>());
+  EXPECT_TRUE(outputs[1]["checks"]["valid"].get<bool>());
+  EXPECT_NEAR(outputs[0]["volume_mm3"].get<double>(), 1000.0 - 512.0, 0.01 * 488.0);
+  EXPECT_EQ(outputs[0]["components"], 2);
+  EXPECT_EQ(outputs[1]["components"], 1);
+  EXPECT_EQ(outputs[1]["genus"], 6 + 12 - 1);
+  const nlohmann::json in = nlohmann::json::parse(read_file(dir / "out" / "report.json"))["inputs"];
+  EXPECT_EQ(in["c1"]["holes"], 6);
+  EXPECT_EQ(in["c1"]["faces"], 6);
 }
 
 TEST(Cli, MalformedInputIsRejectedWithExitTwoAndNothingWritten) {

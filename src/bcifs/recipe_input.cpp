@@ -1,6 +1,7 @@
 #include "bcifs/recipe_input.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <string>
@@ -147,8 +148,12 @@ std::vector<std::vector<Vec2d>> plate_loops(const PlateSpec& spec, int level) {
   std::vector<std::vector<Vec2d>> polygons;
   for (const auto& face : realize_assembly(spec.rules, spec.assembly, spec.controls, level, spec.options))
     for (auto& leaf : face) polygons.push_back(std::move(leaf.polygon));
-  // The union's boundary: leaf edges without their reverse. Chained into loops by following, from each end
-  // point, an unused edge that starts there (in-degree equals out-degree at every vertex, so every chain closes).
+  return union_loops(polygons);
+}
+
+std::vector<std::vector<Vec2d>> union_loops(const std::vector<std::vector<Vec2d>>& polygons) {
+  // Chained by following, from each end point, an unused edge that starts there (in-degree equals out-degree
+  // at every vertex, so every chain closes).
   const auto segments = boundary_segments(polygons);
   auto key = [](const Vec2d& p) { return std::make_pair(p.x, p.y); };
   std::multimap<std::pair<double, double>, size_t> starts;
@@ -163,7 +168,7 @@ std::vector<std::vector<Vec2d>> plate_loops(const PlateSpec& spec, int level) {
       used[s] = 1;
       loop.push_back(segments[s].first);
       const Vec2d end = segments[s].second;
-      if (end.x == segments[first].first.x && end.y == segments[first].first.y) break;
+      if (end == segments[first].first) break;
       size_t next = segments.size();
       auto range = starts.equal_range(key(end));
       for (auto it = range.first; it != range.second; ++it)
@@ -177,6 +182,49 @@ std::vector<std::vector<Vec2d>> plate_loops(const PlateSpec& spec, int level) {
     loops.push_back(std::move(loop));
   }
   return loops;
+}
+
+std::vector<std::vector<Vec3d>> cell_faces(const std::string& cell, double edge_mm) {
+  std::vector<std::vector<Vec3d>> faces;
+  if (cell == "hexahedron") {
+    const double h = edge_mm / 2;
+    auto corner = [&](int i) { return Vec3d{i & 1 ? h : -h, i & 2 ? h : -h, i & 4 ? h : -h}; };
+    for (const auto& f : std::vector<std::array<int, 4>>{
+             {0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}})
+      faces.push_back({corner(f[0]), corner(f[1]), corner(f[2]), corner(f[3])});
+    return faces;
+  }
+  if (cell != "truncated_tetrahedron")
+    throw InvalidInput("expected \"hexahedron\" or \"truncated_tetrahedron\", got \"" + cell + "\"");
+  // The regular tetrahedron (1,1,1), (1,-1,-1), (-1,1,-1), (-1,-1,1) (edge 2 sqrt 2) with each corner cut a
+  // third of the way along its edges: 12 vertices, edges 2 sqrt(2) / 3.
+  const std::array<Vec3d, 4> t = {Vec3d{1, 1, 1}, Vec3d{1, -1, -1}, Vec3d{-1, 1, -1}, Vec3d{-1, -1, 1}};
+  const double scale = edge_mm / (2 * std::sqrt(2.0) / 3);
+  auto cut = [&](int i, int j) { return (t[size_t(i)] * (2.0 / 3) + t[size_t(j)] * (1.0 / 3)) * scale; };
+  for (int i = 0; i < 4; ++i) {
+    // The triangle cut off corner i, and the hexagon opposite it (the face of the other three corners).
+    std::vector<int> others;
+    for (int j = 0; j < 4; ++j)
+      if (j != i) others.push_back(j);
+    std::vector<Vec3d> triangle, hexagon;
+    for (int j : others) triangle.push_back(cut(i, j));
+    for (size_t k = 0; k < 3; ++k) {
+      const int a = others[k], b = others[(k + 1) % 3];
+      hexagon.push_back(cut(a, b));
+      hexagon.push_back(cut(b, a));
+    }
+    for (auto* f : {&triangle, &hexagon}) {
+      // Orient counter-clockwise seen from outside (the centre is the origin).
+      Vec3d n{0, 0, 0}, c{0, 0, 0};
+      for (size_t k = 0; k < f->size(); ++k) {
+        n += cross((*f)[k], (*f)[(k + 1) % f->size()]);
+        c += (*f)[k];
+      }
+      if (dot(n, c) < 0) std::reverse(f->begin(), f->end());
+      faces.push_back(*f);
+    }
+  }
+  return faces;
 }
 
 void register_recipe_inputs() {
@@ -207,6 +255,89 @@ void register_recipe_inputs() {
          in.report = {{"level", spec.level}, {"face_types", spec.rules.rules.size()}, {"faces", faces},
                       {"loops", region.loops_mm.size()}, {"holes", holes}, {"area_mm2", area}};
          in.geometry.regions.push_back(std::move(region));
+       }});
+
+  // A polyhedral cell whose faces are lacunar faces: every face realized in its own plane (its corners as the
+  // control polygon) and extruded inwards by thickness_mm. All edges have one type, so neighbouring faces
+  // subdivide their shared edge the same way and their notches meet.
+  register_input_type(
+      {"bcifs_cell",
+       {"cell", "edge_mm", "center_mm", "edge", "params", "algorithm", "level", "thickness_mm", "gap_fraction",
+        "lacuna_scale", "notch_depth"},
+       [](const JsonObject& o, RecipeInput& in) {
+         const double edge_mm = o.positive_length("edge_mm");
+         std::vector<std::vector<Vec3d>> faces;
+         try {
+           faces = cell_faces(o.string("cell"), edge_mm);
+         } catch (const InvalidInput& e) {
+           o.fail("cell", e.what());
+         }
+         const double thickness = o.positive_length("thickness_mm");
+         if (thickness >= edge_mm / 4) o.fail("thickness_mm", "expected a wall thinner than a quarter of edge_mm");
+         const Vec3d center = o.vec3_or("center_mm", Vec3d{});
+         const uint64_t level = o.unsigned_integer_or("level", 2);
+         if (level > 6) o.fail("level", "expected a level from 0 to 6");
+         EdgeType edge;
+         EdgeSet params;
+         Algorithm algorithm = Algorithm::kA1;
+         try {
+           edge = parse_edge(o.string_or("edge", "C2"));
+         } catch (const InvalidInput& e) {
+           o.fail("edge", e.what());
+         }
+         try {
+           params = parse_edge_set(o.string_or("params", "C2 B2 B2"));
+         } catch (const InvalidInput& e) {
+           o.fail("params", e.what());
+         }
+         try {
+           algorithm = parse_algorithm(o.string_or("algorithm", "A1"));
+         } catch (const InvalidInput& e) {
+           o.fail("algorithm", e.what());
+         }
+         RealizeOptions options;
+         options.defaults.gap_fraction = fraction(o, "gap_fraction", options.defaults.gap_fraction);
+         options.defaults.lacuna_scale = fraction(o, "lacuna_scale", options.defaults.lacuna_scale);
+         options.defaults.notch_depth = fraction(o, "notch_depth", options.defaults.notch_depth);
+         std::vector<FaceType> types;
+         for (const auto& f : faces) types.push_back({std::vector<EdgeType>(f.size(), edge), params, algorithm, 1});
+         RuleSet rules;
+         try {
+           rules = build_rules(types);
+         } catch (const InvalidInput& e) {
+           o.fail("", e.what());
+         }
+         double area = 0;
+         size_t holes = 0;
+         for (size_t k = 0; k < faces.size(); ++k) {
+           const auto& f = faces[k];
+           // The face's plane: origin at its first corner, u along its first edge, v = n x u.
+           Vec3d n{0, 0, 0};
+           for (size_t j = 0; j < f.size(); ++j) n += cross(f[j], f[(j + 1) % f.size()]);
+           n = n / norm(n);
+           const Vec3d u = (f[1] - f[0]) / norm(f[1] - f[0]);
+           const Vec3d v = cross(n, u);
+           std::vector<Vec2d> control;
+           for (const Vec3d& p : f) control.push_back({dot(p - f[0], u), dot(p - f[0], v)});
+           // The type's canonical rotation of a boundary with one edge type is the boundary itself.
+           std::vector<std::vector<Vec2d>> polygons;
+           for (Leaf& leaf : realize(rules, rules.roots[k], control, int(level), options))
+             polygons.push_back(std::move(leaf.polygon));
+           Region2 region;
+           region.loops_mm = union_loops(polygons);
+           for (const auto& loop : region.loops_mm) {
+             const double a = signed_area(loop);
+             area += a;
+             holes += a < 0;
+           }
+           region.origin_mm = center + f[0] - n * thickness;  // the slab spans [-thickness, 0] along n: inwards
+           region.axis_u = u;
+           region.axis_v = v;
+           region.height_mm = thickness;
+           in.geometry.regions.push_back(std::move(region));
+         }
+         in.report = {{"faces", faces.size()}, {"face_types", rules.rules.size()}, {"holes", holes},
+                      {"face_area_mm2", area}};
        }});
 }
 

@@ -33,6 +33,15 @@ PlateSpec parse_plate(const JsonObject& o);
 // counter-clockwise and the lacunas clockwise, for the even-odd rule.
 std::vector<std::vector<Vec2d>> plate_loops(const PlateSpec& spec, int level);
 
+// The boundary of a union of counter-clockwise polygons that meet only along shared edges (identical end
+// points), as closed loops: the edges without their reverse, chained.
+std::vector<std::vector<Vec2d>> union_loops(const std::vector<std::vector<Vec2d>>& polygons);
+
+// The faces of a polyhedral cell centred at the origin, each counter-clockwise seen from outside:
+// "hexahedron" (a cube of edge `edge_mm`) or "truncated_tetrahedron" (4 triangles and 4 hexagons, all edges
+// `edge_mm`). Throws InvalidInput for another name.
+std::vector<std::vector<Vec3d>> cell_faces(const std::string& cell, double edge_mm);
+
 void register_recipe_inputs();
 
 }  // namespace bcifs
