@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -497,6 +498,100 @@ TEST(Bcifs, PlotDrawsEverySeries) {
   EXPECT_GE(blue, 4 * 49);
   EXPECT_GT(green, 100);
   EXPECT_GE(black, 7 * 49);
+}
+
+// ---- curved edges ----
+
+// A quadratic Bézier edge (a, bend, b) adds the parabolic segment 2/3 of the triangle (a, bend, b) to the face;
+// its outline, m chords at equal parameter steps, keeps (1 - 1/m^2) of it.
+TEST(Bcifs, CurvedEdgeOutlineAreaClosedForm) {
+  const RuleSet rules = build_rules(face("B2 B2 B2 B2", "C2 B2 B2"));
+  const std::vector<Vec2d> square = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  const std::vector<Bend> bends = {Vec2d{0.5, -0.4}, Bend{}, Bend{}, Bend{}};
+  const std::vector<Leaf> leaves = realize(rules, 0, square, 0, {}, bends);
+  ASSERT_EQ(leaves.size(), 1u);
+  const double m = kCurveSegments, triangle = 1 * 0.4 / 2;
+  EXPECT_EQ(outline(leaves[0]).size(), 4u + size_t(kCurveSegments) - 1);
+  EXPECT_NEAR(signed_area(outline(leaves[0])), 1 + 2.0 / 3 * triangle * (1 - 1 / (m * m)), 1e-12);
+}
+
+// Every leaf edge the subdivision puts on the curved edge (its end points and every outline point between)
+// lies on the parabola y = -0.8 x (1 - x) of (0,0), (0.5,-0.4), (1,0): the pieces carry the blossoms of the
+// curve. Nothing lies below it.
+TEST(Bcifs, CurvedEdgePiecesLieOnTheCurve) {
+  for (const char* boundary : {"C2 B2 C2 B2", "C3 B2 C2 B3"}) {
+    const RuleSet rules = build_rules(face(boundary, "C2 B2 B2"));
+    const std::vector<Vec2d> square = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    const std::vector<Bend> bends = {Vec2d{0.5, -0.4}, Bend{}, Bend{}, Bend{}};
+    size_t on_curve = 0;
+    for (const Leaf& leaf : realize(rules, 0, square, 3, {}, bends)) {
+      const std::vector<Vec2d> points = outline(leaf);
+      EXPECT_TRUE(is_simple(points)) << boundary;
+      // Nothing outside the face: no point below the curve.
+      for (const Vec2d& p : points) EXPECT_GE(p.y, -0.8 * p.x * (1 - p.x) - 1e-12) << boundary;
+      if (leaf.bends.empty()) continue;
+      // A curved leaf edge and its chords: from its start corner through kCurveSegments - 1 points to its end.
+      size_t at = 0;
+      for (size_t j = 0; j < leaf.polygon.size(); ++j) {
+        const size_t count = leaf.bends[j] ? size_t(kCurveSegments) : 1;
+        for (size_t i = 0; i <= count && leaf.bends[j]; ++i) {
+          const Vec2d& p = points[(at + i) % points.size()];
+          EXPECT_NEAR(p.y, -0.8 * p.x * (1 - p.x), 1e-12) << boundary;
+          ++on_curve;
+        }
+        at += count;
+      }
+    }
+    EXPECT_GT(on_curve, 100u) << boundary;
+  }
+}
+
+// Two faces sharing a curved edge: both sides compute the same doubles along it, so at level 3 the union of
+// all leaves is one region (one outer loop) and its area is the sum of the leaves' areas.
+TEST(Bcifs, SharedCurvedEdgeJoinsExactly) {
+  Assembly a;
+  a.faces = {face("C2 B2 C2 B2", "C2 B2 B2"), face("C2 B2 C2 B2", "C2 B2 B2")};
+  a.shared = {{0, 1, 1, 3}};  // (1,0)->(1,1) of the left square is (1,1)->(1,0) of the right one
+  const RuleSet rules = build_rules(a.faces);
+  const std::vector<std::vector<Vec2d>> controls = {{{0, 0}, {1, 0}, {1, 1}, {0, 1}}, {{1, 0}, {2, 0}, {2, 1}, {1, 1}}};
+  const Vec2d bend{1.3, 0.5};
+  const std::vector<std::vector<Bend>> bends = {{Bend{}, bend, Bend{}, Bend{}}, {Bend{}, Bend{}, Bend{}, bend}};
+  std::vector<std::vector<Vec2d>> all;
+  double leaf_area = 0;
+  for (const auto& leaves : realize_assembly(rules, a, controls, 3, {}, bends))
+    for (const auto& p : polygons_of(leaves)) {
+      leaf_area += signed_area(p);
+      all.push_back(p);
+    }
+  size_t outer = 0;
+  double union_area = 0;
+  std::vector<std::pair<Vec2d, Vec2d>> segments = boundary_segments(all);
+  // The union's outer loops: chain the boundary segments and count the loops of positive area.
+  std::map<std::pair<double, double>, std::vector<size_t>> starts;
+  for (size_t i = 0; i < segments.size(); ++i) starts[{segments[i].first.x, segments[i].first.y}].push_back(i);
+  std::vector<char> used(segments.size(), 0);
+  for (size_t first = 0; first < segments.size(); ++first) {
+    if (used[first]) continue;
+    std::vector<Vec2d> loop;
+    for (size_t s = first;;) {
+      used[s] = 1;
+      loop.push_back(segments[s].first);
+      size_t next = segments.size();
+      for (size_t t : starts[{segments[s].second.x, segments[s].second.y}])
+        if (!used[t]) next = t;
+      if (next == segments.size()) break;
+      s = next;
+    }
+    const double area = signed_area(loop);
+    union_area += area;
+    outer += area > 0;
+  }
+  EXPECT_EQ(outer, 1u);
+  EXPECT_NEAR(union_area, leaf_area, 1e-9);
+  // Bending the shared edge on one side only is refused.
+  auto one_sided = bends;
+  one_sided[1][3] = Bend{};
+  EXPECT_THROW(realize_assembly(rules, a, controls, 1, {}, one_sided), InvalidInput);
 }
 
 }  // namespace

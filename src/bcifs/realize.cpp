@@ -56,6 +56,53 @@ Vec2d combine(const Vec2d& a, const Vec2d& b, const Split& s) {
 
 Vec2d lerp(const Vec2d& a, const Vec2d& b, double t) { return {(1 - t) * a.x + t * b.x, (1 - t) * a.y + t * b.y}; }
 
+// Whether the end points of an edge are in the fixed order curves are evaluated in (lexicographic).
+bool in_order(const Vec2d& a, const Vec2d& b) { return a.x < b.x || (a.x == b.x && a.y <= b.y); }
+
+// The point at split s of the quadratic Bézier (a, bend, b), evaluated from the end point that comes first so
+// that the face across a shared edge, which sees (b, bend, a) at the swapped split, gets the same doubles.
+Vec2d curve_point(const Vec2d& a, const Vec2d& bend, const Vec2d& b, const Split& s) {
+  if (!in_order(a, b)) return curve_point(b, bend, a, {s.v, s.u});
+  const double total = s.u + s.v, ta = s.v / total, tb = s.u / total;
+  const double wa = ta * ta, wm = 2 * ta * tb, wb = tb * tb;
+  return {wa * a.x + wm * bend.x + wb * b.x, wa * a.y + wm * bend.y + wb * b.y};
+}
+
+// The bend of the piece of the curve (a, bend, b) between splits s0 and s1: its blossom b(t0, t1).
+Vec2d curve_piece_bend(const Vec2d& a, const Vec2d& bend, const Vec2d& b, const Split& s0, const Split& s1) {
+  if (!in_order(a, b)) return curve_piece_bend(b, bend, a, {s1.v, s1.u}, {s0.v, s0.u});
+  const double t0 = s0.u + s0.v, t1 = s1.u + s1.v;
+  const double a0 = s0.v / t0, b0 = s0.u / t0, a1 = s1.v / t1, b1 = s1.u / t1;
+  const double wa = a0 * a1, wm = a0 * b1 + b0 * a1, wb = b0 * b1;
+  return {wa * a.x + wm * bend.x + wb * b.x, wa * a.y + wm * bend.y + wb * b.y};
+}
+
+// A point on edge e of a face: on its curve when it has a bend, on the chord otherwise.
+Vec2d edge_point(const std::vector<Vec2d>& control, const std::vector<Bend>& bends, int e, const Split& s) {
+  const size_t n = control.size();
+  const Vec2d& a = control[size_t(e) % n];
+  const Vec2d& b = control[(size_t(e) + 1) % n];
+  if (!bends.empty() && bends[size_t(e) % n]) return curve_point(a, *bends[size_t(e) % n], b, s);
+  return combine(a, b, s);
+}
+
+void check_bends(const FaceRule& rule, const std::vector<Bend>& bends) {
+  if (!bends.empty() && bends.size() != rule.face.boundary.size())
+    throw InvalidInput("bends of " + to_string(rule.face) + ": expected none or " +
+                       std::to_string(rule.face.boundary.size()) + " (one per edge), got " + std::to_string(bends.size()));
+  for (const Bend& b : bends)
+    if (b && !(std::isfinite(b->x) && std::isfinite(b->y)))
+      throw InvalidInput("bends of " + to_string(rule.face) + ": a bend is not finite");
+}
+
+template <class T>
+std::vector<T> rotated(const std::vector<T>& written, int shift) {
+  const size_t n = written.size();
+  std::vector<T> out(n);
+  for (size_t j = 0; j < n; ++j) out[j] = written[(j + size_t(shift)) % n];
+  return out;
+}
+
 const GeometryOptions& options_for(const RealizeOptions& options, int type) {
   const auto found = options.per_type.find(type);
   return found == options.per_type.end() ? options.defaults : found->second;
@@ -78,10 +125,7 @@ void check_type(const RuleSet& rules, int type) {
 
 // The control polygon of a sub-face in its type's canonical order.
 std::vector<Vec2d> canonical_polygon(const SubFace& sub, const std::vector<Vec2d>& written) {
-  const size_t n = written.size();
-  std::vector<Vec2d> out(n);
-  for (size_t j = 0; j < n; ++j) out[j] = written[(j + size_t(sub.shift)) % n];
-  return out;
+  return rotated(written, sub.shift);
 }
 
 using EdgeKey = std::array<double, 4>;
@@ -154,8 +198,9 @@ void validate(const GeometryOptions& options) {
 }
 
 Vec2d vertex_position(const FaceRule& rule, const std::vector<Vec2d>& control, const VertexRef& vertex,
-                      const GeometryOptions& options) {
+                      const GeometryOptions& options, const std::vector<Bend>& bends) {
   check_control(rule, control);
+  check_bends(rule, bends);
   const int n = int(control.size());
   auto corner = [&](int k) { return control[size_t((k % n + n) % n)]; };
   auto lacuna_corner = [&](int k) {
@@ -170,11 +215,11 @@ Vec2d vertex_position(const FaceRule& rule, const std::vector<Vec2d>& control, c
   };
   switch (vertex.kind) {
     case VertexKind::kBoundary:
-      return combine(corner(vertex.edge), corner(vertex.edge + 1), boundary_split(edge_layout(vertex.edge), vertex.index));
+      return edge_point(control, bends, vertex.edge, boundary_split(edge_layout(vertex.edge), vertex.index));
     case VertexKind::kLacunaCorner: return lacuna_corner(vertex.index);
     case VertexKind::kLacunaEdge: return foot(vertex.edge, vertex.index);
     case VertexKind::kNotchApex: {
-      const Vec2d mid = combine(corner(vertex.edge), corner(vertex.edge + 1), joint_split(edge_layout(vertex.edge), vertex.index));
+      const Vec2d mid = edge_point(control, bends, vertex.edge, joint_split(edge_layout(vertex.edge), vertex.index));
       return lerp(mid, foot(vertex.edge, vertex.index), options.notch_depth);
     }
   }
@@ -182,15 +227,52 @@ Vec2d vertex_position(const FaceRule& rule, const std::vector<Vec2d>& control, c
 }
 
 std::vector<std::vector<Vec2d>> subface_polygons(const FaceRule& rule, const std::vector<Vec2d>& control,
-                                                 const GeometryOptions& options) {
+                                                 const GeometryOptions& options, const std::vector<Bend>& bends) {
   check_control(rule, control);
   std::vector<std::vector<Vec2d>> out;
   out.reserve(rule.subfaces.size());
   for (const SubFace& sub : rule.subfaces) {
     std::vector<Vec2d> polygon;
     polygon.reserve(sub.vertices.size());
-    for (const VertexRef& v : sub.vertices) polygon.push_back(vertex_position(rule, control, v, options));
+    for (const VertexRef& v : sub.vertices) polygon.push_back(vertex_position(rule, control, v, options, bends));
     out.push_back(std::move(polygon));
+  }
+  return out;
+}
+
+std::vector<std::vector<Bend>> subface_bends(const FaceRule& rule, const std::vector<Vec2d>& control,
+                                             const GeometryOptions& options, const std::vector<Bend>& bends) {
+  check_control(rule, control);
+  check_bends(rule, bends);
+  std::vector<std::vector<Bend>> out(rule.subfaces.size());
+  if (bends.empty()) return out;
+  const size_t n = control.size();
+  for (size_t s = 0; s < rule.subfaces.size(); ++s) {
+    const SubFace& sub = rule.subfaces[s];
+    out[s].resize(sub.incidence.size());
+    for (size_t j = 0; j < sub.incidence.size(); ++j) {
+      const Incidence& inc = sub.incidence[j];
+      if (inc.role != EdgeRole::kParent || !bends[size_t(inc.parent_edge)]) continue;
+      // Sub-edge k of the parent edge runs from boundary point 2k to 2k + 1, in the parent edge's direction.
+      const Layout l = layout_of(rule.face.boundary[size_t(inc.parent_edge)], options.gap_fraction);
+      out[s][j] = curve_piece_bend(control[size_t(inc.parent_edge)], *bends[size_t(inc.parent_edge)],
+                                   control[(size_t(inc.parent_edge) + 1) % n], boundary_split(l, 2 * inc.sub_edge),
+                                   boundary_split(l, 2 * inc.sub_edge + 1));
+    }
+  }
+  return out;
+}
+
+std::vector<Vec2d> outline(const Leaf& leaf) {
+  if (leaf.bends.empty()) return leaf.polygon;
+  std::vector<Vec2d> out;
+  const size_t n = leaf.polygon.size();
+  for (size_t j = 0; j < n; ++j) {
+    out.push_back(leaf.polygon[j]);
+    if (!leaf.bends[j]) continue;
+    for (int i = 1; i < kCurveSegments; ++i)
+      out.push_back(curve_point(leaf.polygon[j], *leaf.bends[j], leaf.polygon[(j + 1) % n],
+                                {double(i), double(kCurveSegments - i)}));
   }
   return out;
 }
@@ -208,13 +290,20 @@ std::vector<Vec2d> lacuna_polygon(const FaceRule& rule, const std::vector<Vec2d>
 }
 
 std::vector<Leaf> realize(const RuleSet& rules, int type, const std::vector<Vec2d>& control, int levels,
-                          const RealizeOptions& options) {
+                          const RealizeOptions& options, const std::vector<Bend>& bends) {
   check_type(rules, type);
   if (levels < 0) throw InvalidInput("realize: levels must be >= 0, got " + std::to_string(levels));
   check_control(rules.rules[size_t(type)], control);
+  check_bends(rules.rules[size_t(type)], bends);
+  // A leaf keeps bends only while one of its edges is curved.
+  auto trimmed = [](std::vector<Bend> b) {
+    for (const Bend& x : b)
+      if (x) return b;
+    return std::vector<Bend>{};
+  };
   validate(options.defaults);
   for (const auto& entry : options.per_type) validate(entry.second);
-  std::vector<Leaf> leaves{Leaf{control, type}};
+  std::vector<Leaf> leaves{Leaf{control, type, trimmed(bends)}};
   for (int level = 0; level < levels; ++level) {
     double next_count = 0;
     for (const Leaf& leaf : leaves) next_count += double(rules.rules[size_t(leaf.type)].subfaces.size());
@@ -225,10 +314,12 @@ std::vector<Leaf> realize(const RuleSet& rules, int type, const std::vector<Vec2
     next.reserve(size_t(next_count));
     for (const Leaf& leaf : leaves) {
       const FaceRule& rule = rules.rules[size_t(leaf.type)];
-      const std::vector<std::vector<Vec2d>> polygons =
-          subface_polygons(rule, leaf.polygon, options_for(options, leaf.type));
+      const GeometryOptions& o = options_for(options, leaf.type);
+      const std::vector<std::vector<Vec2d>> polygons = subface_polygons(rule, leaf.polygon, o, leaf.bends);
+      const std::vector<std::vector<Bend>> sub_bends = subface_bends(rule, leaf.polygon, o, leaf.bends);
       for (size_t s = 0; s < polygons.size(); ++s)
-        next.push_back(Leaf{canonical_polygon(rule.subfaces[s], polygons[s]), rule.subfaces[s].type});
+        next.push_back(Leaf{canonical_polygon(rule.subfaces[s], polygons[s]), rule.subfaces[s].type,
+                            trimmed(rotated(sub_bends[s], rule.subfaces[s].shift))});
     }
     leaves.swap(next);
   }
@@ -237,7 +328,11 @@ std::vector<Leaf> realize(const RuleSet& rules, int type, const std::vector<Vec2
 
 std::vector<std::vector<Leaf>> realize_assembly(const RuleSet& rules, const Assembly& assembly,
                                                 const std::vector<std::vector<Vec2d>>& controls, int levels,
-                                                const RealizeOptions& options) {
+                                                const RealizeOptions& options,
+                                                const std::vector<std::vector<Bend>>& bends) {
+  if (!bends.empty() && bends.size() != assembly.faces.size())
+    throw InvalidInput("realize_assembly: " + std::to_string(assembly.faces.size()) + " faces but " +
+                       std::to_string(bends.size()) + " lists of bends");
   validate(assembly);
   if (controls.size() != assembly.faces.size())
     throw InvalidInput("realize_assembly: " + std::to_string(assembly.faces.size()) + " faces but " +
@@ -256,6 +351,11 @@ std::vector<std::vector<Leaf>> realize_assembly(const RuleSet& rules, const Asse
     if (!(a0 == b1 && a1 == b0))
       throw InvalidInput("realize_assembly: shared edge " + std::to_string(s) +
                          ": the two sides' control points differ (face_a's edge must be face_b's edge reversed)");
+    auto bend_of = [&](int face, int edge) {
+      return bends.empty() || bends[size_t(face)].empty() ? Bend{} : bends[size_t(face)][size_t(edge)];
+    };
+    if (!(bend_of(e.face_a, e.edge_a) == bend_of(e.face_b, e.edge_b)))
+      throw InvalidInput("realize_assembly: shared edge " + std::to_string(s) + ": the two sides bend it differently");
   }
   std::vector<std::vector<Leaf>> out;
   for (size_t f = 0; f < assembly.faces.size(); ++f) {
@@ -263,9 +363,8 @@ std::vector<std::vector<Leaf>> realize_assembly(const RuleSet& rules, const Asse
     if (type < 0)
       throw InvalidInput("realize_assembly: face " + std::to_string(f) + " is not in the rule set");
     const int shift = canonical_shift(assembly.faces[f].boundary);
-    std::vector<Vec2d> control(controls[f].size());
-    for (size_t j = 0; j < control.size(); ++j) control[j] = controls[f][(j + size_t(shift)) % control.size()];
-    out.push_back(realize(rules, type, control, levels, options));
+    const std::vector<Bend> face_bends = bends.empty() || bends[f].empty() ? std::vector<Bend>{} : rotated(bends[f], shift);
+    out.push_back(realize(rules, type, rotated(controls[f], shift), levels, options, face_bends));
   }
   return out;
 }
@@ -351,13 +450,13 @@ double union_perimeter(const std::vector<std::vector<Vec2d>>& polygons) {
 std::vector<std::vector<Vec2d>> polygons_of(const std::vector<Leaf>& leaves) {
   std::vector<std::vector<Vec2d>> out;
   out.reserve(leaves.size());
-  for (const Leaf& leaf : leaves) out.push_back(leaf.polygon);
+  for (const Leaf& leaf : leaves) out.push_back(outline(leaf));
   return out;
 }
 
 GeometricMeasures geometric_measures(const RuleSet& rules, int type, const std::vector<Vec2d>& control, int levels,
                                      const RealizeOptions& options) {
-  return geometric_measures(rules, std::vector<Leaf>{Leaf{control, type}}, 0, levels, options);
+  return geometric_measures(rules, std::vector<Leaf>{Leaf{control, type, {}}}, 0, levels, options);
 }
 
 GeometricMeasures geometric_measures(const RuleSet& rules, std::vector<Leaf> leaves, int first, int last,
@@ -370,16 +469,17 @@ GeometricMeasures geometric_measures(const RuleSet& rules, std::vector<Leaf> lea
     if (level > 0) {
       std::vector<Leaf> next;
       for (const Leaf& leaf : leaves) {
-        std::vector<Leaf> children = realize(rules, leaf.type, leaf.polygon, 1, options);
+        std::vector<Leaf> children = realize(rules, leaf.type, leaf.polygon, 1, options, leaf.bends);
         next.insert(next.end(), children.begin(), children.end());
       }
       leaves.swap(next);
     }
     if (level < first) continue;
+    const std::vector<std::vector<Vec2d>> polygons = polygons_of(leaves);
     double area = 0;
-    for (const Leaf& leaf : leaves) area += signed_area(leaf.polygon);
+    for (const auto& p : polygons) area += signed_area(p);
     out.area.push_back(area);
-    out.perimeter.push_back(union_perimeter(polygons_of(leaves)));
+    out.perimeter.push_back(union_perimeter(polygons));
   }
   if (last > first) {
     out.area_factor = std::pow(out.area.back() / out.area.front(), 1.0 / (last - first));

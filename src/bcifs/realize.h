@@ -16,11 +16,17 @@
 //   leaves a corner, the El edge cuts the corner of the copy Q, and that corner belongs to the sub-face.
 // - Notch apex in a Cantor gap: (1 - t) m + t f, m the gap's midpoint, f the foot of its adjacency edge (for a
 //   delayed face, the foot it would have), t = notch_depth.
-// Curved (Bézier control point) edges are not implemented: every edge is its straight segment.
+// - Curved edges: a root face's edge j may carry a bend, the middle control point B of the quadratic Bézier
+//   (P[j], B, P[j+1]). Its points then lie on the curve at the same splits (t = u / (u + v)), and a sub-edge
+//   of it carries the blossom of its two parameters as its own bend, so every sub-face edge on the curve is the
+//   exact piece of the curve. Interior edges stay straight. Curves are evaluated with their end points in a
+//   fixed order, so a shared curved edge gives both sides the same doubles. Outlines flatten each curved edge
+//   into kCurveSegments chords of equal parameter steps.
 #pragma once
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -47,14 +53,27 @@ struct RealizeOptions {
 // Throws InvalidInput unless every option is in (0, 1).
 void validate(const GeometryOptions& options);
 
-// The point a VertexRef names, for the rule's face with control polygon `control` (rule.face.boundary order).
-// Throws InvalidInput when control does not have one point per boundary edge.
+// An edge's bend: the middle control point of its quadratic Bézier; none for a straight edge.
+using Bend = std::optional<Vec2d>;
+
+// Chords per curved edge in an outline.
+constexpr int kCurveSegments = 16;
+
+// The point a VertexRef names, for the rule's face with control polygon `control` (rule.face.boundary order)
+// and the bends of its edges (empty: all straight). Throws InvalidInput when control does not have one point
+// per boundary edge, or bends is neither empty nor one per edge.
 Vec2d vertex_position(const FaceRule& rule, const std::vector<Vec2d>& control, const VertexRef& vertex,
-                      const GeometryOptions& options = {});
+                      const GeometryOptions& options = {}, const std::vector<Bend>& bends = {});
 
 // The polygon of each sub-face, vertex j = start of its edge j as written in the rule.
 std::vector<std::vector<Vec2d>> subface_polygons(const FaceRule& rule, const std::vector<Vec2d>& control,
-                                                 const GeometryOptions& options = {});
+                                                 const GeometryOptions& options = {},
+                                                 const std::vector<Bend>& bends = {});
+
+// The bends of each sub-face's edges (as written in the rule): the piece of the parent's curve for an edge on
+// a curved parent edge, none otherwise. Empty lists when the parent has no bends.
+std::vector<std::vector<Bend>> subface_bends(const FaceRule& rule, const std::vector<Vec2d>& control,
+                                             const GeometryOptions& options, const std::vector<Bend>& bends);
 
 // The central lacuna (counter-clockwise), empty for a delayed face.
 std::vector<Vec2d> lacuna_polygon(const FaceRule& rule, const std::vector<Vec2d>& control,
@@ -63,20 +82,27 @@ std::vector<Vec2d> lacuna_polygon(const FaceRule& rule, const std::vector<Vec2d>
 struct Leaf {
   std::vector<Vec2d> polygon;  // one vertex per boundary edge of `type`, in its canonical order
   int type = -1;
+  std::vector<Bend> bends;     // one per edge, or empty when every edge is straight
 };
+
+// The leaf's outline: its polygon with every curved edge flattened into kCurveSegments chords.
+std::vector<Vec2d> outline(const Leaf& leaf);
 
 // The leaves (material) of face type `type` after `levels` subdivisions; control in the type's canonical order.
 // Throws InvalidInput for a bad type, levels < 0 or a control polygon of the wrong size, ResourceLimit past
 // 20 000 000 leaves.
+// `bends`: one per control edge (or empty: all straight), in the same order as control.
 std::vector<Leaf> realize(const RuleSet& rules, int type, const std::vector<Vec2d>& control, int levels,
-                          const RealizeOptions& options = {});
+                          const RealizeOptions& options = {}, const std::vector<Bend>& bends = {});
 
 // The leaves of every face of an assembly; controls[f] follows faces[f].boundary as written (vertex j = start of
 // edge j). Throws InvalidInput when validate(assembly) does, when a face is not in `rules`, or when the two sides
-// of a shared edge do not have the same end points (reversed).
+// of a shared edge do not have the same end points (reversed) or the same bend. bends[f], when given, follows
+// controls[f].
 std::vector<std::vector<Leaf>> realize_assembly(const RuleSet& rules, const Assembly& assembly,
                                                 const std::vector<std::vector<Vec2d>>& controls, int levels,
-                                                const RealizeOptions& options = {});
+                                                const RealizeOptions& options = {},
+                                                const std::vector<std::vector<Bend>>& bends = {});
 
 // The leaf sub-edges (start, end) along edge `edge` (canonical index) of face type `type` after `levels`
 // subdivisions, in order, found through the rules' incidences.
@@ -89,7 +115,7 @@ bool is_simple(const std::vector<Vec2d>& polygon);
 // The edges of the union's boundary: every leaf edge whose reverse (identical end points) is not a leaf edge.
 std::vector<std::pair<Vec2d, Vec2d>> boundary_segments(const std::vector<std::vector<Vec2d>>& polygons);
 double union_perimeter(const std::vector<std::vector<Vec2d>>& polygons);
-std::vector<std::vector<Vec2d>> polygons_of(const std::vector<Leaf>& leaves);
+std::vector<std::vector<Vec2d>> polygons_of(const std::vector<Leaf>& leaves);  // their outlines
 
 struct GeometricMeasures {
   std::vector<double> area;       // A_i, i = 0..levels: sum of leaf areas

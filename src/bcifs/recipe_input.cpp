@@ -19,7 +19,7 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kMaxLeaves = 2e6;
 
 FaceType parse_face(const JsonObject& f) {
-  f.allow_only({"boundary", "params", "algorithm", "delay", "control_mm"});
+  f.allow_only({"boundary", "params", "algorithm", "delay", "control_mm", "bends_mm"});
   FaceType face;
   try {
     face.boundary = parse_boundary(f.string("boundary"));
@@ -65,6 +65,26 @@ std::vector<Vec2d> parse_control(const JsonObject& f, size_t edges, double radiu
   return control;
 }
 
+// "bends_mm": one entry per edge, null for a straight edge or [x, y], the middle control point of the edge's
+// quadratic Bézier.
+std::vector<Bend> parse_bends(const JsonObject& f, size_t edges) {
+  std::vector<Bend> bends;
+  if (!f.has("bends_mm")) return bends;
+  const nlohmann::json& list = f.required("bends_mm");
+  if (!list.is_array() || list.size() != edges)
+    f.fail("bends_mm", "expected " + std::to_string(edges) + " entries (one per edge): null or [x, y]");
+  for (size_t j = 0; j < edges; ++j) {
+    if (list[j].is_null()) {
+      bends.emplace_back();
+      continue;
+    }
+    if (!list[j].is_array() || list[j].size() != 2 || !list[j][0].is_number() || !list[j][1].is_number())
+      f.fail("bends_mm", "entry " + std::to_string(j) + ": expected null or [x, y]");
+    bends.emplace_back(Vec2d{list[j][0].get<double>(), list[j][1].get<double>()});
+  }
+  return bends;
+}
+
 double fraction(const JsonObject& o, const char* key, double fallback) {
   const double v = o.number_or(key, fallback);
   if (!(v > 0 && v < 1)) o.fail(key, "expected a fraction strictly between 0 and 1");
@@ -82,6 +102,7 @@ PlateSpec parse_plate(const JsonObject& o) {
     const JsonObject f = o.object("face");
     spec.assembly.faces.push_back(parse_face(f));
     spec.controls.push_back(parse_control(f, spec.assembly.faces[0].boundary.size(), radius));
+    spec.bends.push_back(parse_bends(f, spec.assembly.faces[0].boundary.size()));
   } else {
     const nlohmann::json& list = o.required("faces");
     if (!list.is_array() || list.empty()) o.fail("faces", "expected a list of faces");
@@ -89,6 +110,7 @@ PlateSpec parse_plate(const JsonObject& o) {
       const JsonObject f(list[i], o.file(), o.path_of("faces") + "[" + std::to_string(i) + "]");
       spec.assembly.faces.push_back(parse_face(f));
       spec.controls.push_back(parse_control(f, spec.assembly.faces.back().boundary.size(), list.size() == 1 ? radius : 0));
+      spec.bends.push_back(parse_bends(f, spec.assembly.faces.back().boundary.size()));
     }
     if (o.has("shared")) {
       const nlohmann::json& shared = o.required("shared");
@@ -137,7 +159,7 @@ PlateSpec parse_plate(const JsonObject& o) {
                         std::to_string(int64_t(leaves)) + " sub-faces, more than 2 000 000; use a lower level");
   // The shared edges must have the same end points (reversed) on both sides.
   try {
-    realize_assembly(spec.rules, spec.assembly, spec.controls, 0, spec.options);
+    realize_assembly(spec.rules, spec.assembly, spec.controls, 0, spec.options, spec.bends);
   } catch (const InvalidInput& e) {
     o.fail(o.has("faces") ? "faces" : "face", e.what());
   }
@@ -146,8 +168,8 @@ PlateSpec parse_plate(const JsonObject& o) {
 
 std::vector<std::vector<Vec2d>> plate_loops(const PlateSpec& spec, int level) {
   std::vector<std::vector<Vec2d>> polygons;
-  for (const auto& face : realize_assembly(spec.rules, spec.assembly, spec.controls, level, spec.options))
-    for (auto& leaf : face) polygons.push_back(std::move(leaf.polygon));
+  for (const auto& face : realize_assembly(spec.rules, spec.assembly, spec.controls, level, spec.options, spec.bends))
+    for (auto& outline : polygons_of(face)) polygons.push_back(std::move(outline));
   return union_loops(polygons);
 }
 
@@ -320,11 +342,8 @@ void register_recipe_inputs() {
            std::vector<Vec2d> control;
            for (const Vec3d& p : f) control.push_back({dot(p - f[0], u), dot(p - f[0], v)});
            // The type's canonical rotation of a boundary with one edge type is the boundary itself.
-           std::vector<std::vector<Vec2d>> polygons;
-           for (Leaf& leaf : realize(rules, rules.roots[k], control, int(level), options))
-             polygons.push_back(std::move(leaf.polygon));
            Region2 region;
-           region.loops_mm = union_loops(polygons);
+           region.loops_mm = union_loops(polygons_of(realize(rules, rules.roots[k], control, int(level), options)));
            for (const auto& loop : region.loops_mm) {
              const double a = signed_area(loop);
              area += a;

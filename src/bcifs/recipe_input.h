@@ -16,6 +16,7 @@ namespace bcifs {
 struct PlateSpec {
   Assembly assembly;                         // one face and no shared edges for a single face
   std::vector<std::vector<Vec2d>> controls;  // per face, mm, one point per boundary edge (vertex j starts edge j)
+  std::vector<std::vector<Bend>> bends;      // per face: one per edge (curved edges), or empty
   RuleSet rules;                             // built from the faces (roots in face order)
   RealizeOptions options;
   int level = 3;
@@ -23,7 +24,7 @@ struct PlateSpec {
   Vec3d origin_mm;
 };
 
-// Reads a `bcifs_plate` object: "face" {boundary, params, algorithm, delay, control_mm} or "faces" [...] with
+// Reads a `bcifs_plate` object: "face" {boundary, params, algorithm, delay, control_mm, bends_mm} or "faces" [...] with
 // "shared" [{face_a, edge_a, face_b, edge_b}], "level", "thickness_mm", "radius_mm" (a face without control_mm
 // is the regular polygon of that circumradius), "gap_fraction", "lacuna_scale", "notch_depth", "origin_mm".
 // Fails (InvalidInput naming the file and key) on anything malformed.

@@ -109,7 +109,7 @@ int bcifs_measure(const BcifsArgs& a) {
     }
     entry["topology"] = faces;
     std::vector<bcifs::Leaf> faces_at_level_0;
-    for (auto& face : bcifs::realize_assembly(spec.rules, spec.assembly, spec.controls, 0, spec.options))
+    for (auto& face : bcifs::realize_assembly(spec.rules, spec.assembly, spec.controls, 0, spec.options, spec.bends))
       faces_at_level_0.insert(faces_at_level_0.end(), face.begin(), face.end());
     std::vector<std::vector<Vec2d>> top_polygons;
     const bcifs::GeometricMeasures m =
