@@ -184,14 +184,6 @@ void detect_symmetry(Motif2& m) {
   }
 }
 
-void check_law(double c, double N, double gap, double boundary_gap, size_t trials) {
-  if (!(std::isfinite(c) && c > 1)) throw InvalidInput("fill: the exponent c must be > 1, got " + number(c));
-  if (!(std::isfinite(N) && N > 1)) throw InvalidInput("fill: the offset N must be > 1, got " + number(N));
-  if (!(std::isfinite(gap) && gap >= 0)) throw InvalidInput("fill: gap_mm must be >= 0, got " + number(gap));
-  if (!(std::isfinite(boundary_gap) && boundary_gap >= 0))
-    throw InvalidInput("fill: boundary_gap_mm must be >= 0, got " + number(boundary_gap));
-  if (trials == 0) throw InvalidInput("fill: max_trials must be at least 1");
-}
 
 }  // namespace
 
@@ -294,6 +286,15 @@ bool overlap(const Shape2& a, const Shape2& b, double gap) {
   if (outlines_intersect(a.points, b.points)) return true;
   if (point_in_polygon(b.points, a.interior) || point_in_polygon(a.points, b.interior)) return true;
   return gap > 0 && vertex_outline_distance(a.points, b.points) < gap;
+}
+
+void check_law(double c, double N, double gap, double boundary_gap, size_t trials) {
+  if (!(std::isfinite(c) && c > 1)) throw InvalidInput("fill: the exponent c must be > 1, got " + number(c));
+  if (!(std::isfinite(N) && N > 1)) throw InvalidInput("fill: the offset N must be > 1, got " + number(N));
+  if (!(std::isfinite(gap) && gap >= 0)) throw InvalidInput("fill: gap_mm must be >= 0, got " + number(gap));
+  if (!(std::isfinite(boundary_gap) && boundary_gap >= 0))
+    throw InvalidInput("fill: boundary_gap_mm must be >= 0, got " + number(boundary_gap));
+  if (trials == 0) throw InvalidInput("fill: max_trials must be at least 1");
 }
 
 std::string trials_reason(const char* what, size_t i, size_t trials) {
@@ -470,9 +471,8 @@ bool contains(const FillRegion2& region, const Motif2& motif, const Placement2& 
 }
 
 FillResult2 fill_region(const FillRegion2& region, const Motif2& motif, const FillOptions& options) {
-  check_law(options.c, options.N, options.gap_mm, options.boundary_gap_mm, options.max_trials);
+  detail::check_law(options.c, options.N, options.gap_mm, options.boundary_gap_mm, options.max_trials);
   const double A = area(region);
-  const double zeta = hurwitz_zeta(options.c, options.N);
   Vec2d lo, hi;
   region_box(region, lo, hi);
   const bool turn = options.random_rotation && motif.kind == Motif2::Kind::kPolygon;
@@ -481,84 +481,57 @@ FillResult2 fill_region(const FillRegion2& region, const Motif2& motif, const Fi
   detail::GridIndex<2> index;
   std::vector<detail::Shape2> shapes;
   FillResult2 result;
-  result.stop_reason = "max_count";
-  for (size_t i = 0; i < options.max_count; ++i) {
-    const double fraction = 1 / (zeta * std::pow(options.N + double(i), options.c));
-    const double area_i = A * fraction;
-    if (area_i < options.min_area_mm2) {
-      result.stop_reason = "min_area";
-      return result;
-    }
-    Placement2 pl;
-    pl.area_mm2 = area_i;
-    pl.scale = std::sqrt(area_i);
-    bool placed = false;
-    for (size_t trial = 0; trial < options.max_trials && !placed; ++trial) {
-      pl.center_mm = {lo.x + (hi.x - lo.x) * random.uniform(), lo.y + (hi.y - lo.y) * random.uniform()};
-      if (turn) pl.angle_rad = turn_range * random.uniform();
-      detail::Shape2 s = detail::place(motif, pl);
-      if (!contains_shape(region, s, options.boundary_gap_mm)) continue;
-      if (index.any({s.center.x, s.center.y}, s.radius + options.gap_mm,
-                    [&](int id) { return detail::overlap(s, shapes[size_t(id)], options.gap_mm); }))
-        continue;
-      index.insert(int(shapes.size()), {s.center.x, s.center.y}, s.radius);
-      shapes.push_back(std::move(s));
-      placed = true;
-    }
-    if (!placed) {
-      result.stop_reason = detail::trials_reason("motif", i, options.max_trials);
-      return result;
-    }
-    result.motifs.push_back(pl);
-    result.fill_fraction += fraction;
-  }
+  result.fill_fraction = detail::place_by_rule(
+      A, options.c, options.N, options.max_count, options.min_area_mm2, "min_area", options.max_trials, "motif",
+      result.stop_reason, [&](size_t, double area_i) {
+        Placement2 pl;
+        pl.area_mm2 = area_i;
+        pl.scale = std::sqrt(area_i);
+        pl.center_mm = {lo.x + (hi.x - lo.x) * random.uniform(), lo.y + (hi.y - lo.y) * random.uniform()};
+        if (turn) pl.angle_rad = turn_range * random.uniform();
+        detail::Shape2 s = detail::place(motif, pl);
+        if (!contains_shape(region, s, options.boundary_gap_mm)) return false;
+        if (index.any({s.center.x, s.center.y}, s.radius + options.gap_mm,
+                      [&](int id) { return detail::overlap(s, shapes[size_t(id)], options.gap_mm); }))
+          return false;
+        index.insert(int(shapes.size()), {s.center.x, s.center.y}, s.radius);
+        shapes.push_back(std::move(s));
+        result.motifs.push_back(pl);
+        return true;
+      });
   return result;
 }
 
 FillResult3 fill_spheres(const SignedDistance3& signed_distance_mm, const Box3& box, double volume_mm3,
                          const FillOptions3& options) {
-  check_law(options.c, options.N, options.gap_mm, options.boundary_gap_mm, options.max_trials);
+  detail::check_law(options.c, options.N, options.gap_mm, options.boundary_gap_mm, options.max_trials);
   if (!signed_distance_mm) throw InvalidInput("fill_spheres needs a signed distance function");
   if (box.empty() || !is_finite(box.min) || !is_finite(box.max)) throw InvalidInput("fill_spheres needs a finite, non-empty box");
   if (!(std::isfinite(volume_mm3) && volume_mm3 > 0))
     throw InvalidInput("fill_spheres needs a region volume > 0, got " + number(volume_mm3));
-  const double zeta = hurwitz_zeta(options.c, options.N);
   Random random(options.seed);
   detail::GridIndex<3> index;
   FillResult3 result;
-  result.stop_reason = "max_count";
-  for (size_t i = 0; i < options.max_count; ++i) {
-    const double fraction = 1 / (zeta * std::pow(options.N + double(i), options.c));
-    const double volume_i = volume_mm3 * fraction;
-    if (volume_i < options.min_volume_mm3) {
-      result.stop_reason = "min_volume";
-      return result;
-    }
-    const double r = std::cbrt(3 * volume_i / (4 * kPi));
-    // A sphere inside the region lies in the box shrunk by r + boundary gap; centres are drawn there.
-    const double m = r + options.boundary_gap_mm;
-    const Vec3d lo = box.min + Vec3d{m, m, m}, hi = box.max - Vec3d{m, m, m};
-    bool placed = false;
-    for (size_t trial = 0; trial < options.max_trials && !placed; ++trial) {
-      const Vec3d c{lo.x + (hi.x - lo.x) * random.uniform(), lo.y + (hi.y - lo.y) * random.uniform(),
-                    lo.z + (hi.z - lo.z) * random.uniform()};
-      if (lo.x > hi.x || lo.y > hi.y || lo.z > hi.z) continue;
-      if (!(signed_distance_mm(c) <= -m)) continue;
-      if (index.any({c.x, c.y, c.z}, r + options.gap_mm, [&](int id) {
-            return norm(result.centers_mm[size_t(id)] - c) < result.radii_mm[size_t(id)] + r + options.gap_mm;
-          }))
-        continue;
-      index.insert(int(result.centers_mm.size()), {c.x, c.y, c.z}, r);
-      result.centers_mm.push_back(c);
-      result.radii_mm.push_back(r);
-      placed = true;
-    }
-    if (!placed) {
-      result.stop_reason = detail::trials_reason("sphere", i, options.max_trials);
-      return result;
-    }
-    result.fill_fraction += fraction;
-  }
+  result.fill_fraction = detail::place_by_rule(
+      volume_mm3, options.c, options.N, options.max_count, options.min_volume_mm3, "min_volume", options.max_trials,
+      "sphere", result.stop_reason, [&](size_t, double volume_i) {
+        const double r = std::cbrt(3 * volume_i / (4 * kPi));
+        // A sphere inside the region lies in the box shrunk by r + boundary gap; centres are drawn there.
+        const double m = r + options.boundary_gap_mm;
+        const Vec3d lo = box.min + Vec3d{m, m, m}, hi = box.max - Vec3d{m, m, m};
+        const Vec3d c{lo.x + (hi.x - lo.x) * random.uniform(), lo.y + (hi.y - lo.y) * random.uniform(),
+                      lo.z + (hi.z - lo.z) * random.uniform()};
+        if (lo.x > hi.x || lo.y > hi.y || lo.z > hi.z) return false;
+        if (!(signed_distance_mm(c) <= -m)) return false;
+        if (index.any({c.x, c.y, c.z}, r + options.gap_mm, [&](int id) {
+              return norm(result.centers_mm[size_t(id)] - c) < result.radii_mm[size_t(id)] + r + options.gap_mm;
+            }))
+          return false;
+        index.insert(int(result.centers_mm.size()), {c.x, c.y, c.z}, r);
+        result.centers_mm.push_back(c);
+        result.radii_mm.push_back(r);
+        return true;
+      });
   return result;
 }
 

@@ -229,15 +229,7 @@ bool polyhedra_overlap(const Motif3& a, const Placement3& pa, const Motif3& b, c
 
 FillResult3P fill_polyhedra(const SignedDistance3& signed_distance_mm, const Box3& box, double volume_mm3,
                             const Motif3& motif, const FillOptions3& options, bool random_rotation) {
-  if (!(std::isfinite(options.c) && options.c > 1))
-    throw InvalidInput("fill: the exponent c must be > 1, got " + number(options.c));
-  if (!(std::isfinite(options.N) && options.N > 1))
-    throw InvalidInput("fill: the offset N must be > 1, got " + number(options.N));
-  if (!(std::isfinite(options.gap_mm) && options.gap_mm >= 0))
-    throw InvalidInput("fill: gap_mm must be >= 0, got " + number(options.gap_mm));
-  if (!(std::isfinite(options.boundary_gap_mm) && options.boundary_gap_mm >= 0))
-    throw InvalidInput("fill: boundary_gap_mm must be >= 0, got " + number(options.boundary_gap_mm));
-  if (options.max_trials == 0) throw InvalidInput("fill: max_trials must be at least 1");
+  detail::check_law(options.c, options.N, options.gap_mm, options.boundary_gap_mm, options.max_trials);
   if (!signed_distance_mm) throw InvalidInput("fill_polyhedra needs a signed distance function");
   if (box.empty() || !is_finite(box.min) || !is_finite(box.max))
     throw InvalidInput("fill_polyhedra needs a finite, non-empty box");
@@ -245,53 +237,37 @@ FillResult3P fill_polyhedra(const SignedDistance3& signed_distance_mm, const Box
     throw InvalidInput("fill_polyhedra needs a region volume > 0, got " + number(volume_mm3));
   check_motif(motif);
   const MotifFrame frame = frame_of(motif);
-  const double zeta = hurwitz_zeta(options.c, options.N);
   const double g = options.boundary_gap_mm;
   Random random(options.seed);
   detail::GridIndex<3> index;
   std::vector<Shape3> shapes;
   FillResult3P result;
-  result.stop_reason = "max_count";
-  for (size_t i = 0; i < options.max_count; ++i) {
-    const double fraction = 1 / (zeta * std::pow(options.N + double(i), options.c));
-    const double volume_i = volume_mm3 * fraction;
-    if (volume_i < options.min_volume_mm3) {
-      result.stop_reason = "min_volume";
-      return result;
-    }
-    Placement3 pl;
-    pl.volume_mm3 = volume_i;
-    pl.scale = std::cbrt(volume_i);
-    // The motif reaches at least its inradius from its centroid in every direction, so a motif inside the
-    // region has its centre in the box shrunk by that plus the boundary gap; centres are drawn there.
-    const double m = pl.scale * frame.inradius + g;
-    const Vec3d lo = box.min + Vec3d{m, m, m}, hi = box.max - Vec3d{m, m, m};
-    bool placed = false;
-    for (size_t trial = 0; trial < options.max_trials && !placed; ++trial) {
-      pl.center_mm = {lo.x + (hi.x - lo.x) * random.uniform(), lo.y + (hi.y - lo.y) * random.uniform(),
-                      lo.z + (hi.z - lo.z) * random.uniform()};
-      if (random_rotation) pl.rotation = random_rotation_matrix(random);
-      if (lo.x > hi.x || lo.y > hi.y || lo.z > hi.z) continue;
-      bool inside = true;
-      for (size_t k = 0; k < frame.probes.size() && inside; ++k)
-        inside = signed_distance_mm(pl.center_mm + rotate(pl.rotation, frame.probes[k]) * pl.scale) <= -g;
-      if (!inside) continue;
-      Shape3 s = place(motif, frame, pl);
-      const double gap = options.gap_mm;
-      if (index.any({s.center.x, s.center.y, s.center.z}, s.radius + gap,
-                    [&](int id) { return overlap(s, shapes[size_t(id)], gap); }))
-        continue;
-      index.insert(int(shapes.size()), {s.center.x, s.center.y, s.center.z}, s.radius);
-      shapes.push_back(std::move(s));
-      placed = true;
-    }
-    if (!placed) {
-      result.stop_reason = detail::trials_reason("motif", i, options.max_trials);
-      return result;
-    }
-    result.motifs.push_back(pl);
-    result.fill_fraction += fraction;
-  }
+  result.fill_fraction = detail::place_by_rule(
+      volume_mm3, options.c, options.N, options.max_count, options.min_volume_mm3, "min_volume", options.max_trials,
+      "motif", result.stop_reason, [&](size_t, double volume_i) {
+        Placement3 pl;
+        pl.volume_mm3 = volume_i;
+        pl.scale = std::cbrt(volume_i);
+        // The motif reaches at least its inradius from its centroid in every direction, so a motif inside the
+        // region has its centre in the box shrunk by that plus the boundary gap; centres are drawn there.
+        const double m = pl.scale * frame.inradius + g;
+        const Vec3d lo = box.min + Vec3d{m, m, m}, hi = box.max - Vec3d{m, m, m};
+        pl.center_mm = {lo.x + (hi.x - lo.x) * random.uniform(), lo.y + (hi.y - lo.y) * random.uniform(),
+                        lo.z + (hi.z - lo.z) * random.uniform()};
+        if (random_rotation) pl.rotation = random_rotation_matrix(random);
+        if (lo.x > hi.x || lo.y > hi.y || lo.z > hi.z) return false;
+        for (size_t k = 0; k < frame.probes.size(); ++k)
+          if (!(signed_distance_mm(pl.center_mm + rotate(pl.rotation, frame.probes[k]) * pl.scale) <= -g)) return false;
+        Shape3 s = place(motif, frame, pl);
+        const double gap = options.gap_mm;
+        if (index.any({s.center.x, s.center.y, s.center.z}, s.radius + gap,
+                      [&](int id) { return overlap(s, shapes[size_t(id)], gap); }))
+          return false;
+        index.insert(int(shapes.size()), {s.center.x, s.center.y, s.center.z}, s.radius);
+        shapes.push_back(std::move(s));
+        result.motifs.push_back(pl);
+        return true;
+      });
   return result;
 }
 

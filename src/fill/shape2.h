@@ -52,6 +52,38 @@ bool overlap(const Shape2& a, const Shape2& b, double gap_mm);
 // The stop reason of a fill whose motif i found no room: "max_trials: <what> i could not be placed in T trials".
 std::string trials_reason(const char* what, size_t i, size_t trials);
 
+// Throws InvalidInput unless c > 1, N > 1, both gaps >= 0 and trials >= 1.
+void check_law(double c, double N, double gap, double boundary_gap, size_t trials);
+
+// The area (volume) rule, shared by every fill: motif i takes the fraction 1 / (zeta(c, N) (N + i)^c) of
+// `measure`. For i = 0 .. max_count - 1 it stops with `min_reason` once that part is below `min_part`;
+// otherwise it calls trial(i, part) up to max_trials times, until one places the motif (returns true), and
+// stops with trials_reason(what, ...) when none did. Sets stop_reason ("max_count" when every motif was
+// placed) and returns the fraction of `measure` placed.
+template <class Trial>
+double place_by_rule(double measure, double c, double N, size_t max_count, double min_part, const char* min_reason,
+                     size_t max_trials, const char* what, std::string& stop_reason, Trial&& trial) {
+  const double zeta = hurwitz_zeta(c, N);
+  double filled = 0;
+  stop_reason = "max_count";
+  for (size_t i = 0; i < max_count; ++i) {
+    const double fraction = 1 / (zeta * std::pow(N + double(i), c));
+    const double part = measure * fraction;
+    if (part < min_part) {
+      stop_reason = min_reason;
+      return filled;
+    }
+    bool placed = false;
+    for (size_t t = 0; t < max_trials && !placed; ++t) placed = trial(i, part);
+    if (!placed) {
+      stop_reason = trials_reason(what, i, max_trials);
+      return filled;
+    }
+    filled += fraction;
+  }
+  return filled;
+}
+
 // A hierarchical uniform grid: an entry of radius r lives in the level whose cell size h = 2^L is the
 // smallest power of two >= r, in the one cell holding its centre; a query visits, on each level, the cells
 // within reach + h of the query point (or the level's whole list, when that is shorter). Since motifs only

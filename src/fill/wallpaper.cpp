@@ -396,55 +396,42 @@ WallpaperFill fill_wallpaper(Group group, const Lattice& lattice, const Motif2& 
   detail::GridIndex<2> index;
   std::vector<detail::Shape2> shapes;  // images of the placed motifs near the fundamental region
   FillResult2& result = out.fundamental;
-  result.stop_reason = "max_count";
-  for (size_t i = 0; i < options.max_count; ++i) {
-    const double fraction = 1 / (zeta * std::pow(options.N + double(i), options.c));
-    const double area_i = A * fraction;
-    if (area_i < options.min_area_mm2) {
-      result.stop_reason = "min_area";
-      return out;
-    }
-    bool placed = false;
-    for (size_t trial = 0; trial < options.max_trials && !placed; ++trial) {
-      // Uniform in the fundamental region: uniform in its cell-coordinate box, kept when inside.
-      Vec2d f;
-      do f = {lo.x + (hi.x - lo.x) * random.uniform(), lo.y + (hi.y - lo.y) * random.uniform()};
-      while (!detail::point_in_polygon(cell_region, f));
-      Placement2 pl;
-      pl.center_mm = pattern.frame.to_world(f);
-      pl.area_mm2 = area_i;
-      pl.scale = std::sqrt(area_i);
-      if (turn) pl.angle_rad = turn_range * random.uniform();
-      if (policy == BoundaryPolicy::kSnap && !snap(pattern, motif, region, pl)) continue;
-      const detail::Shape2 s = detail::place(motif, pl);
-      const double gap = options.gap_mm;
-      if (index.any({s.center.x, s.center.y}, s.radius + gap,
-                    [&](int id) { return detail::overlap(s, shapes[size_t(id)], gap); }))
-        continue;
-      // Its own images: those that could come within the gap, except the ones the policy lets it overlap.
-      bool clear = true;
-      pattern.images(s.center, s.center, 2 * s.radius + gap, [&](const Element& e, const Vec2d& q) {
-        if (!clear || is_identity(e)) return;
-        if (policy == BoundaryPolicy::kSnap && length2(q - s.center) <= pattern.tol) return;  // its stabilizer
-        if (policy == BoundaryPolicy::kAllow && cuts(e.map, s, pattern.tol)) return;
-        if (detail::overlap(s, detail::place(motif, transform(e.map, pl)), gap)) clear = false;
+  result.fill_fraction = detail::place_by_rule(
+      A, options.c, options.N, options.max_count, options.min_area_mm2, "min_area", options.max_trials, "motif",
+      result.stop_reason, [&](size_t, double area_i) {
+        // Uniform in the fundamental region: uniform in its cell-coordinate box, kept when inside.
+        Vec2d f;
+        do f = {lo.x + (hi.x - lo.x) * random.uniform(), lo.y + (hi.y - lo.y) * random.uniform()};
+        while (!detail::point_in_polygon(cell_region, f));
+        Placement2 pl;
+        pl.center_mm = pattern.frame.to_world(f);
+        pl.area_mm2 = area_i;
+        pl.scale = std::sqrt(area_i);
+        if (turn) pl.angle_rad = turn_range * random.uniform();
+        if (policy == BoundaryPolicy::kSnap && !snap(pattern, motif, region, pl)) return false;
+        const detail::Shape2 s = detail::place(motif, pl);
+        const double gap = options.gap_mm;
+        if (index.any({s.center.x, s.center.y}, s.radius + gap,
+                      [&](int id) { return detail::overlap(s, shapes[size_t(id)], gap); }))
+          return false;
+        // Its own images: those that could come within the gap, except the ones the policy lets it overlap.
+        bool clear = true;
+        pattern.images(s.center, s.center, 2 * s.radius + gap, [&](const Element& e, const Vec2d& q) {
+          if (!clear || is_identity(e)) return;
+          if (policy == BoundaryPolicy::kSnap && length2(q - s.center) <= pattern.tol) return;  // its stabilizer
+          if (policy == BoundaryPolicy::kAllow && cuts(e.map, s, pattern.tol)) return;
+          if (detail::overlap(s, detail::place(motif, transform(e.map, pl)), gap)) clear = false;
+        });
+        if (!clear) return false;
+        // Keep every image that a later motif in the fundamental region could come near.
+        pattern.images(s.center, mid, region_radius + s.radius + largest + gap, [&](const Element& e, const Vec2d&) {
+          detail::Shape2 image = detail::place(motif, transform(e.map, pl));
+          index.insert(int(shapes.size()), {image.center.x, image.center.y}, image.radius);
+          shapes.push_back(std::move(image));
+        });
+        result.motifs.push_back(pl);
+        return true;
       });
-      if (!clear) continue;
-      // Keep every image that a later motif in the fundamental region could come near.
-      pattern.images(s.center, mid, region_radius + s.radius + largest + gap, [&](const Element& e, const Vec2d&) {
-        detail::Shape2 image = detail::place(motif, transform(e.map, pl));
-        index.insert(int(shapes.size()), {image.center.x, image.center.y}, image.radius);
-        shapes.push_back(std::move(image));
-      });
-      result.motifs.push_back(pl);
-      placed = true;
-    }
-    if (!placed) {
-      result.stop_reason = detail::trials_reason("motif", i, options.max_trials);
-      return out;
-    }
-    result.fill_fraction += fraction;
-  }
   return out;
 }
 
