@@ -12,21 +12,14 @@
 #include "solids/check.h"
 #include "solids/extract.h"
 #include "solids/voxelize.h"
+#include "tests/solid_fixtures.h"
 
 namespace lacuna {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-Volume box(const Vec3d& lo, const Vec3d& hi, double h) {
-  GeometrySet set;
-  Shape s;
-  s.kind = Shape::Kind::kBox;
-  s.center_mm = (lo + hi) * 0.5;
-  s.half_size_mm = (hi - lo) * 0.5;
-  set.shapes.push_back(s);
-  return voxelize(set, VolumeOptions{h, 3.0});
-}
+using test::box;
 
 TEST(FillSolids, PerforatedPlateLosesExactlyTheHoles) {
   // Circles and hexagons placed in a 20 x 15 mm rectangle, 1 mm from its border, cut through a

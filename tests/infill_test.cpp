@@ -14,21 +14,14 @@
 #include "solids/printability.h"
 #include "solids/repair.h"
 #include "solids/voxelize.h"
+#include "tests/solid_fixtures.h"
 
 namespace lacuna {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-Volume box(const Vec3d& lo, const Vec3d& hi, double h) {
-  GeometrySet set;
-  Shape s;
-  s.kind = Shape::Kind::kBox;
-  s.center_mm = (lo + hi) * 0.5;
-  s.half_size_mm = (hi - lo) * 0.5;
-  set.shapes.push_back(s);
-  return voxelize(set, VolumeOptions{h, 3.0});
-}
+using test::box;
 
 Volume ball(const Vec3d& c, double r, double h) {
   GeometrySet set;
