@@ -1,57 +1,42 @@
 #include "solids/check.h"
 
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Polygon_mesh_processing/self_intersections.h>
-#include <CGAL/Surface_mesh.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
-#include <tbb/parallel_sort.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <numeric>
 #include <unordered_map>
 
 #include "solids/components.h"
-#include "solids/disjoint_sets.h"
+#include "solids/exact.h"
+#include "solids/mesh_topology.h"
 #include "util/progress.h"
 
 namespace lacuna {
 namespace {
 
-using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Point = Kernel::Point_3;
-using SurfaceMesh = CGAL::Surface_mesh<Point>;
-
-struct HalfEdge {
-  uint64_t key;  // (min vertex << 32) | max vertex
-  uint32_t id;   // 3 * face + corner; the half-edge runs from corner to corner + 1
-  bool operator<(const HalfEdge& o) const { return key != o.key ? key < o.key : id < o.id; }
-};
-
 // Orientation of (a, b, p) in the (y, z) projection, exact, with p moved by the infinitesimal
 // (eps, eps^2) when it lies on the line ab (simulation of simplicity): two triangles sharing an
 // edge then never both contain p, and a ray through a vertex or along an edge is counted once.
 int orient_yz(const Vec3d& a, const Vec3d& b, const Vec3d& p) {
-  CGAL::Orientation o = CGAL::orientation(Kernel::Point_2(a.y, a.z), Kernel::Point_2(b.y, b.z), Kernel::Point_2(p.y, p.z));
-  if (o != CGAL::COLLINEAR) return o == CGAL::LEFT_TURN ? 1 : -1;
+  int o = exact::orient2d(a.y, a.z, b.y, b.z, p.y, p.z);
+  if (o != 0) return o;
   if (b.z != a.z) return b.z > a.z ? -1 : 1;
   return b.y > a.y ? 1 : (b.y < a.y ? -1 : 0);
 }
 
 // Whether the ray from p along +x crosses triangle abc (exact predicates).
 bool ray_crosses(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& p) {
-  CGAL::Orientation projected =
-      CGAL::orientation(Kernel::Point_2(a.y, a.z), Kernel::Point_2(b.y, b.z), Kernel::Point_2(c.y, c.z));
-  if (projected == CGAL::COLLINEAR) return false;  // parallel to the ray
-  int s = projected == CGAL::LEFT_TURN ? 1 : -1;
+  int s = exact::orient2d(a.y, a.z, b.y, b.z, c.y, c.z);
+  if (s == 0) return false;  // parallel to the ray
   if (orient_yz(a, b, p) != s || orient_yz(b, c, p) != s || orient_yz(c, a, p) != s) return false;
-  CGAL::Orientation side = CGAL::orientation(Point(a.x, a.y, a.z), Point(b.x, b.y, b.z), Point(c.x, c.y, c.z),
-                                             Point(p.x, p.y, p.z));
-  if (side == CGAL::COPLANAR) return false;
+  int side = exact::orient3d(a, b, c, p);
+  if (side == 0) return false;
   // The plane meets the ray ahead of p when p lies on the side the +x direction leaves.
-  return (side == CGAL::POSITIVE ? 1 : -1) * s < 0;
+  return side * s < 0;
 }
 
 // For every component, how many other components enclose it: the parity of the crossings of a
@@ -110,58 +95,215 @@ std::vector<uint32_t> nesting_depths(const TriMesh& mesh, const std::vector<uint
   return depth;
 }
 
-// CGAL's test run on slabs of the mesh in parallel: faces sorted along the longest axis, cut
-// into slabs, every face handed to each slab its box overlaps, so every pair of faces whose boxes
-// meet is tested in some slab. CGAL's own parallel mode shuffles the boxes and ran no faster than
-// one thread here.
-bool self_intersects(const TriMesh& mesh, const Box3& box, bool& built, Progress& progress) {
-  SurfaceMesh sm;
-  sm.reserve(SurfaceMesh::size_type(mesh.positions_mm.size()), SurfaceMesh::size_type(mesh.triangles.size() * 3 / 2),
-             SurfaceMesh::size_type(mesh.triangles.size()));
-  for (const Vec3d& p : mesh.positions_mm) sm.add_vertex(Point(p.x, p.y, p.z));
-  built = true;
-  for (const auto& t : mesh.triangles) {
-    auto f = sm.add_face(SurfaceMesh::Vertex_index(t[0]), SurfaceMesh::Vertex_index(t[1]),
-                         SurfaceMesh::Vertex_index(t[2]));
-    if (f == SurfaceMesh::null_face()) {
-      built = false;
-      return false;
+// Whether the closed fan of faces around v is the graph of a function over one of the three
+// coordinate planes: every face projects with the same strict orientation and the projected
+// fan winds exactly once around v. Then its faces meet only in the edges and the vertex they
+// share, so no pair of faces sharing v needs a test of its own. Exact: orientations by
+// exact predicates, the winding by counting the steps that cross the ray from v along the first
+// projected axis (all steps turn the same way by less than a half turn).
+bool fan_is_graph(const TriMesh& mesh, const EdgeTopology& edges, uint32_t start_corner, uint32_t v) {
+  Vec3d normal;
+  const Vec3d& p = mesh.positions_mm[v];
+  for (uint32_t c = start_corner, steps = 0;; ++steps) {
+    const auto& t = mesh.triangles[c / 3];
+    const Vec3d &a = mesh.positions_mm[t[0]], &b = mesh.positions_mm[t[1]], &d = mesh.positions_mm[t[2]];
+    normal += cross(b - a, d - a);
+    c = edges.opposite[previous_half_edge(c)];
+    if (c == start_corner) break;
+    if (c == kNoHalfEdge || steps > 4096) return false;
+  }
+  const int k = std::fabs(normal.x) >= std::fabs(normal.y) && std::fabs(normal.x) >= std::fabs(normal.z)
+                    ? 0
+                    : (std::fabs(normal.y) >= std::fabs(normal.z) ? 1 : 2);
+  const int i = (k + 1) % 3, j = (k + 2) % 3;  // (i, j, k) right-handed
+  const int sign = normal[k] > 0 ? 1 : -1;
+  int crossings = 0;
+  for (uint32_t c = start_corner;;) {
+    const auto& t = mesh.triangles[c / 3];
+    const uint32_t a = t[(c % 3 + 1) % 3], b = t[(c % 3 + 2) % 3];  // (v, a, b) counter-clockwise
+    const Vec3d &pa = mesh.positions_mm[a], &pb = mesh.positions_mm[b];
+    if (exact::orient2d(p[i], p[j], pa[i], pa[j], pb[i], pb[j]) != sign) return false;
+    // Counter-clockwise in the projection seen from +k: a step from below the line through v to
+    // on or above it crosses the ray along +i; clockwise (sign < 0) mirrors it.
+    const bool a_low = pa[j] < p[j], b_low = pb[j] < p[j];
+    if (sign > 0 ? (a_low && !b_low) : (!a_low && b_low)) ++crossings;
+    c = edges.opposite[previous_half_edge(c)];
+    if (c == start_corner) break;
+  }
+  return crossings == 1;
+}
+
+// Triangle boxes rounded outwards to float, so a box test never misses a touching pair.
+struct FaceBox {
+  float lo[3], hi[3];
+};
+
+float down(double v) {
+  float f = float(v);
+  return double(f) > v ? std::nextafter(f, -HUGE_VALF) : f;
+}
+float up(double v) {
+  float f = float(v);
+  return double(f) < v ? std::nextafter(f, HUGE_VALF) : f;
+}
+
+// Whether any two faces meet other than in the vertices or edge they share (exact predicates).
+// Broad phase: a uniform grid over the faces' boxes, every face listed in each cell its box
+// overlaps; a pair whose boxes overlap is tested only in the cell holding the lowest corner of
+// the boxes' overlap, so each candidate pair is tested once. Cells start at twice the typical
+// face's width (the square root of the mean area) and grow until the grid holds at most 8 cells
+// and the lists 16 entries per face, so long or large faces among small ones cost a bounded number
+// of entries. Pairs sharing a vertex whose fan is a graph over a coordinate plane need no test of
+// their own (fan_is_graph). Faces listed in `skip` (degenerate ones, reported separately) take no
+// part.
+bool self_intersects(const TriMesh& mesh, const EdgeTopology& edges, const VertexCorners& corners,
+                     const std::vector<uint8_t>& skip, Progress& progress) {
+  const size_t nf = mesh.triangles.size(), nv = mesh.positions_mm.size();
+  std::vector<uint8_t> graph_fan(nv, 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 4096), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t v = range.begin(); v != range.end(); ++v)
+      if (corners.degree(uint32_t(v)) > 0)
+        graph_fan[v] = fan_is_graph(mesh, edges, corners.corners[corners.offsets[v]], uint32_t(v));
+  });
+  std::vector<FaceBox> boxes(nf);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nf, 8192), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t f = range.begin(); f != range.end(); ++f) {
+      const auto& t = mesh.triangles[f];
+      for (int k = 0; k < 3; ++k) {
+        const double a = mesh.positions_mm[t[0]][k], b = mesh.positions_mm[t[1]][k], c = mesh.positions_mm[t[2]][k];
+        boxes[f].lo[k] = down(std::min({a, b, c}));
+        boxes[f].hi[k] = up(std::max({a, b, c}));
+      }
     }
-  }
-  const size_t nf = mesh.triangles.size();
-  Vec3d extent = box.size();
-  int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
-  struct Span {
-    double lo, hi;
-  };
-  std::vector<Span> spans(nf);
-  std::vector<double> centres(nf);
+  });
+  double origin[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, top[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  long double area2 = 0;
   for (size_t f = 0; f < nf; ++f) {
+    for (int k = 0; k < 3; ++k) {
+      origin[k] = std::min(origin[k], double(boxes[f].lo[k]));
+      top[k] = std::max(top[k], double(boxes[f].hi[k]));
+    }
     const auto& t = mesh.triangles[f];
-    double a = mesh.positions_mm[t[0]][axis], b = mesh.positions_mm[t[1]][axis], c = mesh.positions_mm[t[2]][axis];
-    spans[f] = {std::min({a, b, c}), std::max({a, b, c})};
-    centres[f] = (spans[f].lo + spans[f].hi) * 0.5;
+    area2 += norm(cross(mesh.positions_mm[t[1]] - mesh.positions_mm[t[0]], mesh.positions_mm[t[2]] - mesh.positions_mm[t[0]]));
   }
-  const size_t slabs = std::clamp<size_t>(nf / 50000, 1, 64);
-  std::vector<double> cuts;  // slab j is [cuts[j], cuts[j + 1]]
+  const double span = std::max({top[0] - origin[0], top[1] - origin[1], top[2] - origin[2]});
+  double cell = std::max(2 * std::sqrt(double(area2 / 2) / double(nf)), span * 1e-6);
+  if (!(cell > 0)) cell = 1;
+  int64_t dims[3];
+  auto cell_of = [&](double v, int k) {
+    double i = std::floor((v - origin[k]) / cell);
+    return int64_t(std::clamp(i, 0.0, double(dims[k] - 1)));
+  };
+  for (;;) {
+    double cells = 1;
+    for (int k = 0; k < 3; ++k) {
+      dims[k] = int64_t(std::floor((top[k] - origin[k]) / cell)) + 1;
+      cells *= double(dims[k]);
+    }
+    if (cells > 8.0 * double(nf) + 64) {
+      cell *= 1.25;
+      continue;
+    }
+    const uint64_t entries = tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(0, nf, 8192), uint64_t{0},
+        [&](const tbb::blocked_range<size_t>& range, uint64_t n) {
+          for (size_t f = range.begin(); f != range.end(); ++f) {
+            uint64_t m = 1;
+            for (int k = 0; k < 3; ++k) m *= uint64_t(cell_of(boxes[f].hi[k], k) - cell_of(boxes[f].lo[k], k) + 1);
+            n += m;
+          }
+          return n;
+        },
+        std::plus<uint64_t>());
+    if (entries > 16 * uint64_t(nf) + 1024) {
+      cell *= 1.5;
+      continue;
+    }
+    break;
+  }
+  const size_t ncells = size_t(dims[0] * dims[1] * dims[2]);
+  // The cell of every box's lowest corner: the overlap of two boxes starts in the larger of theirs.
+  std::vector<std::array<int32_t, 3>> low_cell(nf);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nf, 8192), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t f = range.begin(); f != range.end(); ++f)
+      for (int k = 0; k < 3; ++k) low_cell[f][size_t(k)] = int32_t(cell_of(boxes[f].lo[k], k));
+  });
+  auto for_cells = [&](size_t f, auto&& visit) {
+    const FaceBox& b = boxes[f];
+    const int64_t x0 = cell_of(b.lo[0], 0), x1 = cell_of(b.hi[0], 0), y0 = cell_of(b.lo[1], 1),
+                  y1 = cell_of(b.hi[1], 1), z0 = cell_of(b.lo[2], 2), z1 = cell_of(b.hi[2], 2);
+    for (int64_t x = x0; x <= x1; ++x)
+      for (int64_t y = y0; y <= y1; ++y)
+        for (int64_t z = z0; z <= z1; ++z) visit(size_t((x * dims[1] + y) * dims[2] + z));
+  };
+  // Counting sort of (cell, face) entries; the order inside a cell does not matter.
+  std::vector<uint32_t> start(ncells + 1, 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nf, 8192), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t f = range.begin(); f != range.end(); ++f)
+      if (!skip[f]) for_cells(f, [&](size_t c) { __atomic_fetch_add(&start[c + 1], 1u, __ATOMIC_RELAXED); });
+  });
+  for (size_t c = 0; c < ncells; ++c) start[c + 1] += start[c];
+  std::vector<uint32_t> entries(start[ncells]);
   {
-    std::vector<double> sorted = centres;
-    std::sort(sorted.begin(), sorted.end());
-    cuts.push_back(-HUGE_VAL);
-    for (size_t j = 1; j < slabs; ++j) cuts.push_back(sorted[j * nf / slabs]);
-    cuts.push_back(HUGE_VAL);
+    std::vector<uint32_t> cursor(start.begin(), start.end() - 1);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, nf, 8192), [&](const tbb::blocked_range<size_t>& range) {
+      for (size_t f = range.begin(); f != range.end(); ++f)
+        if (!skip[f])
+          for_cells(f, [&](size_t c) { entries[__atomic_fetch_add(&cursor[c], 1u, __ATOMIC_RELAXED)] = uint32_t(f); });
+    });
   }
-  std::vector<std::vector<SurfaceMesh::Face_index>> members(slabs);
-  for (size_t f = 0; f < nf; ++f) {
-    size_t first = size_t(std::upper_bound(cuts.begin(), cuts.end(), spans[f].lo) - cuts.begin()) - 1;
-    for (size_t j = first; j < slabs && cuts[j] <= spans[f].hi; ++j)
-      members[j].push_back(SurfaceMesh::Face_index(uint32_t(f)));
-  }
+  progress.advance(4);
   std::atomic<bool> hit{false};
-  tbb::parallel_for(size_t(0), slabs, [&](size_t j) {
-    if (hit) return;
-    if (CGAL::Polygon_mesh_processing::does_self_intersect<CGAL::Sequential_tag>(members[j], sm)) hit = true;
-    progress.advance(16 / slabs + (j < 16 % slabs ? 1 : 0));
+  const size_t chunks = 12;
+  // Each cell's faces are gathered once into a local list, so the pair loop reads nothing else.
+  struct Local {
+    FaceBox box;
+    std::array<int32_t, 3> low;
+    std::array<uint32_t, 3> v;
+    uint32_t graph_fans;  // bit k: v[k] has a graph fan
+    uint32_t face;
+  };
+  tbb::parallel_for(size_t(0), chunks, [&](size_t chunk) {
+    const size_t c0 = ncells * chunk / chunks, c1 = ncells * (chunk + 1) / chunks;
+    tbb::parallel_for(tbb::blocked_range<size_t>(c0, c1, 1024), [&](const tbb::blocked_range<size_t>& range) {
+      std::vector<Local> local;
+      for (size_t c = range.begin(); c != range.end() && !hit.load(std::memory_order_relaxed); ++c) {
+        const uint32_t* list = entries.data() + start[c];
+        const size_t n = start[c + 1] - start[c];
+        if (n < 2) continue;
+        const int64_t cz = int64_t(c) % dims[2], cy = (int64_t(c) / dims[2]) % dims[1], cx = int64_t(c) / (dims[1] * dims[2]);
+        const int32_t here[3] = {int32_t(cx), int32_t(cy), int32_t(cz)};
+        local.resize(n);
+        for (size_t i = 0; i < n; ++i) {
+          const uint32_t f = list[i];
+          const auto& t = mesh.triangles[f];
+          local[i] = {boxes[f], low_cell[f], t,
+                      uint32_t(graph_fan[t[0]]) | uint32_t(graph_fan[t[1]]) << 1 | uint32_t(graph_fan[t[2]]) << 2, f};
+        }
+        for (size_t i = 0; i + 1 < n; ++i) {
+          const Local& a = local[i];
+          for (size_t j = i + 1; j < n; ++j) {
+            const Local& b = local[j];
+            if (!(a.box.lo[0] <= b.box.hi[0] && b.box.lo[0] <= a.box.hi[0] && a.box.lo[1] <= b.box.hi[1] &&
+                  b.box.lo[1] <= a.box.hi[1] && a.box.lo[2] <= b.box.hi[2] && b.box.lo[2] <= a.box.hi[2]))
+              continue;
+            if (std::max(a.low[0], b.low[0]) != here[0] || std::max(a.low[1], b.low[1]) != here[1] ||
+                std::max(a.low[2], b.low[2]) != here[2])
+              continue;
+            bool in_graph_fan = false;
+            for (int k = 0; k < 3; ++k)
+              if ((a.graph_fans >> k & 1) && (a.v[size_t(k)] == b.v[0] || a.v[size_t(k)] == b.v[1] || a.v[size_t(k)] == b.v[2]))
+                in_graph_fan = true;
+            if (in_graph_fan) continue;
+            if (exact::faces_intersect(mesh.positions_mm.data(), a.v, b.v)) {
+              hit = true;
+              return;
+            }
+          }
+        }
+      }
+    });
+    progress.advance(1);
   });
   return hit;
 }
@@ -212,138 +354,58 @@ MeshCheckReport check_mesh(const TriMesh& mesh, const CheckOptions& options) {
     if (!is_finite(p)) ++r.non_finite_vertices;
     else r.bounding_box.expand(p);
   }
-  std::vector<uint8_t> face_ok(nf, 1);
-  for (size_t f = 0; f < nf; ++f) {
-    const auto& t = mesh.triangles[f];
-    for (uint32_t v : t)
-      if (v >= nv) {
-        ++r.bad_indices;
-        face_ok[f] = 0;
-      }
-  }
+  for (size_t f = 0; f < nf; ++f)
+    for (uint32_t v : mesh.triangles[f])
+      if (v >= nv) ++r.bad_indices;
   if (nf == 0 || r.bad_indices || r.non_finite_vertices) return r;
 
   Progress progress("check", 4 + 16);
   // Degenerate faces: a repeated corner or three collinear corners (exact predicate).
+  std::vector<uint8_t> degenerate(nf, 0);
   r.degenerate_faces = tbb::parallel_reduce(
       tbb::blocked_range<size_t>(0, nf, 4096), uint64_t{0},
       [&](const tbb::blocked_range<size_t>& range, uint64_t n) {
         for (size_t f = range.begin(); f != range.end(); ++f) {
           const auto& t = mesh.triangles[f];
-          if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
+          if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2] ||
+              exact::collinear(mesh.positions_mm[t[0]], mesh.positions_mm[t[1]], mesh.positions_mm[t[2]])) {
+            degenerate[f] = 1;
             ++n;
-            continue;
           }
-          const Vec3d &a = mesh.positions_mm[t[0]], &b = mesh.positions_mm[t[1]], &c = mesh.positions_mm[t[2]];
-          if (CGAL::collinear(Point(a.x, a.y, a.z), Point(b.x, b.y, b.z), Point(c.x, c.y, c.z))) ++n;
         }
         return n;
       },
       std::plus<uint64_t>());
   progress.advance();
-
   // Edges: every undirected edge must have exactly two faces running it in opposite directions.
-  std::vector<HalfEdge> half_edges(3 * nf);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, nf, 4096), [&](const tbb::blocked_range<size_t>& range) {
-    for (size_t f = range.begin(); f != range.end(); ++f) {
-      const auto& t = mesh.triangles[f];
-      for (int k = 0; k < 3; ++k) {
-        uint64_t a = t[k], b = t[(k + 1) % 3];
-        half_edges[3 * f + k] = HalfEdge{(std::min(a, b) << 32) | std::max(a, b), uint32_t(3 * f + k)};
-      }
-    }
-  });
-  tbb::parallel_sort(half_edges.begin(), half_edges.end());
-  std::vector<uint32_t> opposite(3 * nf, UINT32_MAX);
-  auto tail = [&](uint32_t he) { return mesh.triangles[he / 3][he % 3]; };
-  std::vector<uint64_t> edge_keys;
-  edge_keys.reserve(3 * nf / 2);
-  for (size_t i = 0; i < half_edges.size();) {
-    size_t j = i;
-    while (j < half_edges.size() && half_edges[j].key == half_edges[i].key) ++j;
-    size_t n = j - i;
-    uint64_t key = half_edges[i].key;
-    if ((key >> 32) != (key & 0xffffffffu)) {  // edges of degenerate (repeated-corner) faces aside
-      edge_keys.push_back(key);
-      if (n == 1) {
-        ++r.boundary_edges;
-      } else if (n > 2) {
-        ++r.non_manifold_edges;
-      } else {
-        uint32_t h0 = half_edges[i].id, h1 = half_edges[i + 1].id;
-        if (tail(h0) == tail(h1)) {
-          ++r.misoriented_edges;
-        } else {
-          opposite[h0] = h1;
-          opposite[h1] = h0;
-        }
-      }
-    }
-    i = j;
-  }
-  r.edges = edge_keys.size();
-  std::vector<HalfEdge>().swap(half_edges);
+  const VertexCorners corners = vertex_corners(mesh);
+  const EdgeTopology edges = edge_topology(mesh, corners);
+  r.edges = edges.edges;
+  r.boundary_edges = edges.boundary_edges;
+  r.non_manifold_edges = edges.non_manifold_edges;
+  r.misoriented_edges = edges.misoriented_edges;
   progress.advance();
-
   // Vertex manifoldness: the faces around each vertex form one fan, closed around it.
-  const bool edges_clean = r.boundary_edges == 0 && r.non_manifold_edges == 0 && r.misoriented_edges == 0;
-  std::vector<uint32_t> degree(nv, 0), some_out(nv, UINT32_MAX);
-  for (size_t f = 0; f < nf; ++f)
-    for (int k = 0; k < 3; ++k) {
-      uint32_t v = mesh.triangles[f][k];
-      ++degree[v];
-      if (some_out[v] == UINT32_MAX) some_out[v] = uint32_t(3 * f + k);
-    }
+  const bool edges_clean = edges.clean();
   if (edges_clean) {
-    r.non_manifold_vertices = tbb::parallel_reduce(
-        tbb::blocked_range<size_t>(0, nv, 4096), uint64_t{0},
-        [&](const tbb::blocked_range<size_t>& range, uint64_t n) {
-          for (size_t v = range.begin(); v != range.end(); ++v) {
-            if (degree[v] == 0) continue;
-            uint32_t start = some_out[v], he = start, fan = 0;
-            do {
-              uint32_t prev = 3 * (he / 3) + (he % 3 + 2) % 3;  // ends at v
-              he = opposite[prev];                           // starts at v in the next face
-              ++fan;
-            } while (he != start && he != UINT32_MAX && fan <= degree[v]);
-            if (fan != degree[v]) ++n;
-          }
-          return n;
-        },
-        std::plus<uint64_t>());
+    const std::vector<uint32_t> fans = vertex_fans(mesh, edges, corners);
+    r.non_manifold_vertices = uint64_t(std::count_if(fans.begin(), fans.end(), [](uint32_t n) { return n > 1; }));
     r.vertex_manifold_checked = true;
   }
   progress.advance();
-
   // Components, genus, volume and area.
-  DisjointSets sets(nv);
-  for (const auto& t : mesh.triangles) {
-    sets.join(t[0], t[1]);
-    sets.join(t[1], t[2]);
-  }
-  std::vector<uint32_t> component_of(nv, UINT32_MAX);
-  std::vector<uint32_t> root_component(nv, UINT32_MAX);
-  for (size_t v = 0; v < nv; ++v) {
-    if (degree[v] == 0) continue;
-    uint32_t root = sets.find(uint32_t(v));
-    if (root_component[root] == UINT32_MAX) root_component[root] = uint32_t(r.components++);
-    component_of[v] = root_component[root];
-  }
-  const size_t nc = r.components;
-  std::vector<int64_t> euler(nc, 0);
+  const VertexComponents components = vertex_components(mesh);
+  const size_t nc = components.count;
+  r.components = nc;
+  const std::vector<int64_t> euler = euler_characteristics(mesh, edges, components);
   std::vector<long double> volume6(nc, 0);
-  for (size_t v = 0; v < nv; ++v)
-    if (component_of[v] != UINT32_MAX) ++euler[component_of[v]];
-  for (uint64_t key : edge_keys) --euler[component_of[key >> 32]];
   const Vec3d center = (r.bounding_box.min + r.bounding_box.max) * 0.5;
   long double area2 = 0;
   for (size_t f = 0; f < nf; ++f) {
     const auto& t = mesh.triangles[f];
-    uint32_t c = component_of[t[0]];
-    ++euler[c];
     Vec3d a = mesh.positions_mm[t[0]] - center, b = mesh.positions_mm[t[1]] - center,
           d = mesh.positions_mm[t[2]] - center;
-    volume6[c] += dot(a, cross(b, d));
+    volume6[components.of_vertex[t[0]]] += dot(a, cross(b, d));
     area2 += norm(cross(b - a, d - a));
   }
   long double total6 = 0;
@@ -358,17 +420,14 @@ MeshCheckReport check_mesh(const TriMesh& mesh, const CheckOptions& options) {
   // must have negative volume; every other component positive.
   if (edges_clean) {
     r.orientation_checked = true;
-    std::vector<uint32_t> depth = nesting_depths(mesh, component_of, nc);
+    std::vector<uint32_t> depth = nesting_depths(mesh, components.of_vertex, nc);
     for (size_t c = 0; c < nc; ++c)
       if ((volume6[c] > 0) != (depth[c] % 2 == 0)) ++r.inward_components;
   }
   progress.advance();
-
   if (options.self_intersections && edges_clean && r.non_manifold_vertices == 0) {
-    bool built = false;
-    bool hit = self_intersects(mesh, r.bounding_box, built, progress);
-    r.self_intersections_checked = built;
-    r.self_intersecting = built && hit;
+    r.self_intersecting = self_intersects(mesh, edges, corners, degenerate, progress);
+    r.self_intersections_checked = true;
   }
   return r;
 }

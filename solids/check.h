@@ -13,7 +13,7 @@
 namespace lacuna {
 
 struct CheckOptions {
-  bool self_intersections = true;  // run CGAL's self-intersection test (the slowest check)
+  bool self_intersections = true;  // test every pair of nearby faces for intersections (the slowest check)
 };
 
 struct MeshCheckReport {

@@ -1,0 +1,217 @@
+#include "solids/mesh_topology.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "solids/disjoint_sets.h"
+
+namespace lacuna {
+namespace {
+
+// Buckets keyed by vertex, filled in increasing order of the item: offsets[v] .. offsets[v + 1].
+template <class KeyOf, class ItemOf, class Item>
+void bucket_by_vertex(size_t nv, size_t items, KeyOf&& key_of, ItemOf&& item_of, std::vector<uint64_t>& offsets,
+                      std::vector<Item>& out) {
+  offsets.assign(nv + 1, 0);
+  for (size_t i = 0; i < items; ++i) {
+    const uint32_t v = key_of(i);
+    if (v != UINT32_MAX) ++offsets[v + 1];
+  }
+  for (size_t v = 0; v < nv; ++v) offsets[v + 1] += offsets[v];
+  out.resize(offsets[nv]);
+  std::vector<uint64_t> cursor(offsets.begin(), offsets.end() - 1);
+  for (size_t i = 0; i < items; ++i) {
+    const uint32_t v = key_of(i);
+    if (v != UINT32_MAX) out[cursor[v]++] = item_of(i);
+  }
+}
+
+}  // namespace
+
+EdgeTopology edge_topology(const TriMesh& mesh) { return edge_topology(mesh, vertex_corners(mesh)); }
+
+EdgeTopology edge_topology(const TriMesh& mesh, const VertexCorners& corners) {
+  const size_t nv = mesh.positions_mm.size(), nh = 3 * mesh.triangles.size();
+  if (nh >= UINT32_MAX) throw std::length_error("a mesh with more than 1.4 billion triangles");
+  EdgeTopology r;
+  r.opposite.assign(nh, kNoHalfEdge);
+  r.low_edges.assign(nv, 0);
+  struct Counts {
+    uint64_t edges = 0, boundary = 0, non_manifold = 0, misoriented = 0;
+  };
+  // Each edge {v, w} with v < w is settled at v: its half-edges are v -> w (a corner c at v whose
+  // next corner is w) and w -> v (the half-edge before a corner at v whose previous corner is w).
+  const size_t blocks = std::max<size_t>(1, std::min<size_t>(256, nv / 4096 + 1));
+  std::vector<Counts> counts(blocks);
+  std::vector<std::vector<uint32_t>> boundary(blocks), non_manifold(blocks), misoriented(blocks);
+  tbb::parallel_for(size_t(0), blocks, [&](size_t block) {
+    const size_t v0 = nv * block / blocks, v1 = nv * (block + 1) / blocks;
+    Counts& c = counts[block];
+    std::vector<uint64_t> keys;  // (other vertex << 32) | half-edge
+    for (size_t v = v0; v < v1; ++v) {
+      keys.clear();
+      for (uint64_t i = corners.offsets[v]; i < corners.offsets[v + 1]; ++i) {
+        const uint32_t corner = corners.corners[i];
+        const auto& t = mesh.triangles[corner / 3];
+        const uint32_t next = t[(corner % 3 + 1) % 3], previous = t[(corner % 3 + 2) % 3];
+        if (next > v) keys.push_back((uint64_t(next) << 32) | corner);
+        if (previous > v) keys.push_back((uint64_t(previous) << 32) | previous_half_edge(corner));
+      }
+      std::sort(keys.begin(), keys.end());
+      for (size_t i = 0; i < keys.size();) {
+        size_t j = i;
+        while (j < keys.size() && (keys[j] >> 32) == (keys[i] >> 32)) ++j;
+        const uint32_t h = uint32_t(keys[i]);
+        ++c.edges;
+        ++r.low_edges[v];
+        const size_t n = j - i;
+        if (n == 1) {
+          ++c.boundary;
+          boundary[block].push_back(h);
+        } else if (n > 2) {
+          ++c.non_manifold;
+          non_manifold[block].push_back(h);
+        } else {
+          const uint32_t g = uint32_t(keys[i + 1]);
+          if (half_edge_from(mesh, h) == half_edge_from(mesh, g)) {
+            ++c.misoriented;
+            misoriented[block].push_back(h);
+          } else {
+            r.opposite[h] = g;
+            r.opposite[g] = h;
+          }
+        }
+        i = j;
+      }
+    }
+  });
+  for (size_t b = 0; b < blocks; ++b) {
+    r.edges += counts[b].edges;
+    r.boundary_edges += counts[b].boundary;
+    r.non_manifold_edges += counts[b].non_manifold;
+    r.misoriented_edges += counts[b].misoriented;
+    r.boundary.insert(r.boundary.end(), boundary[b].begin(), boundary[b].end());
+    r.non_manifold.insert(r.non_manifold.end(), non_manifold[b].begin(), non_manifold[b].end());
+    r.misoriented.insert(r.misoriented.end(), misoriented[b].begin(), misoriented[b].end());
+  }
+  std::sort(r.boundary.begin(), r.boundary.end());
+  std::sort(r.non_manifold.begin(), r.non_manifold.end());
+  std::sort(r.misoriented.begin(), r.misoriented.end());
+  return r;
+}
+
+VertexCorners vertex_corners(const TriMesh& mesh) {
+  VertexCorners r;
+  bucket_by_vertex(
+      mesh.positions_mm.size(), 3 * mesh.triangles.size(), [&](size_t c) { return mesh.triangles[c / 3][c % 3]; },
+      [](size_t c) { return uint32_t(c); }, r.offsets, r.corners);
+  return r;
+}
+
+std::vector<uint32_t> vertex_fans(const TriMesh& mesh, const EdgeTopology& edges, const VertexCorners& corners) {
+  const size_t nv = mesh.positions_mm.size();
+  std::vector<uint32_t> fans(nv, 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 4096), [&](const tbb::blocked_range<size_t>& range) {
+    std::vector<uint8_t> seen;
+    for (size_t v = range.begin(); v != range.end(); ++v) {
+      const uint32_t* first = corners.corners.data() + corners.offsets[v];
+      const uint32_t* last = corners.corners.data() + corners.offsets[v + 1];
+      const size_t d = size_t(last - first);
+      if (d == 0) continue;
+      seen.assign(d, 0);
+      auto mark = [&](uint32_t corner) {
+        const uint32_t* at = std::lower_bound(first, last, corner);
+        if (at == last || *at != corner) return false;  // a repeated corner: no fan through it
+        uint8_t& s = seen[size_t(at - first)];
+        if (s) return false;
+        s = 1;
+        return true;
+      };
+      uint32_t count = 0;
+      for (size_t i = 0; i < d; ++i) {
+        if (seen[i]) continue;
+        ++count;
+        seen[i] = 1;
+        // Around v: the corner at v in the face across the edge entering v, until the fan closes
+        // or ends on a boundary; then the other way from the start.
+        bool closed = false;
+        for (uint32_t c = first[i];;) {
+          const uint32_t across = edges.opposite[previous_half_edge(c)];
+          if (across == kNoHalfEdge) break;
+          if (across == first[i]) {
+            closed = true;
+            break;
+          }
+          if (!mark(across)) break;
+          c = across;
+        }
+        if (closed) continue;
+        for (uint32_t c = first[i];;) {
+          const uint32_t across = edges.opposite[c];
+          if (across == kNoHalfEdge) break;
+          const uint32_t corner = next_half_edge(across);
+          if (!mark(corner)) break;
+          c = corner;
+        }
+      }
+      fans[v] = count;
+    }
+  });
+  return fans;
+}
+
+std::vector<std::vector<uint32_t>> boundary_loops(const TriMesh& mesh, const EdgeTopology& edges) {
+  std::vector<uint32_t> next(mesh.positions_mm.size(), UINT32_MAX);
+  for (uint32_t h : edges.boundary) next[half_edge_from(mesh, h)] = half_edge_to(mesh, h);
+  std::vector<std::vector<uint32_t>> loops;
+  std::vector<uint8_t> seen(mesh.positions_mm.size(), 0);
+  for (uint32_t h : edges.boundary) {
+    const uint32_t start = half_edge_from(mesh, h);
+    if (seen[start]) continue;
+    std::vector<uint32_t> loop;
+    for (uint32_t w = start; w != UINT32_MAX && !seen[w]; w = next[w]) {
+      seen[w] = 1;
+      loop.push_back(w);
+    }
+    loops.push_back(std::move(loop));
+  }
+  return loops;
+}
+
+VertexComponents vertex_components(const TriMesh& mesh) {
+  const size_t nv = mesh.positions_mm.size();
+  DisjointSets sets(nv);
+  std::vector<uint8_t> used(nv, 0);
+  for (const auto& t : mesh.triangles) {
+    sets.join(t[0], t[1]);
+    sets.join(t[1], t[2]);
+    used[t[0]] = used[t[1]] = used[t[2]] = 1;
+  }
+  VertexComponents r;
+  r.of_vertex.assign(nv, UINT32_MAX);
+  std::vector<uint32_t> of_root(nv, UINT32_MAX);
+  for (size_t v = 0; v < nv; ++v) {
+    if (!used[v]) continue;
+    const uint32_t root = sets.find(uint32_t(v));
+    if (of_root[root] == UINT32_MAX) of_root[root] = r.count++;
+    r.of_vertex[v] = of_root[root];
+  }
+  return r;
+}
+
+std::vector<int64_t> euler_characteristics(const TriMesh& mesh, const EdgeTopology& edges,
+                                           const VertexComponents& components) {
+  std::vector<int64_t> euler(components.count, 0);
+  for (size_t v = 0; v < components.of_vertex.size(); ++v) {
+    const uint32_t c = components.of_vertex[v];
+    if (c == UINT32_MAX) continue;
+    euler[c] += 1 - int64_t(edges.low_edges[v]);
+  }
+  for (const auto& t : mesh.triangles) ++euler[components.of_vertex[t[0]]];
+  return euler;
+}
+
+}  // namespace lacuna
