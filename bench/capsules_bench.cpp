@@ -15,11 +15,15 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/run_recipe.h"
+#include "solids/check.h"
 #include "solids/extract.h"
+#include "solids/mesh_distance.h"
+#include "solids/simplify.h"
 #include "solids/rasterize.h"
 #include "solids/volume.h"
 #include "solids/voxelize.h"
 #include "util/system.h"
+#include "export/mesh_io.h"
 
 namespace lacuna {
 namespace {
@@ -135,6 +139,8 @@ int run_bench(int argc, char** argv) {
   size_t count = 1000;
   double radius = 0.5, step = 0.5, box = 20.0;
   bool soup = false, full = false;
+  double simplify_mm = 0;
+  bool hausdorff = false;
   int threads = 0;
   std::string out_dir = "capsules-bench-out";
   app.add_option("--count", count, "Number of capsules (segments of the walk)");
@@ -144,6 +150,8 @@ int run_bench(int argc, char** argv) {
   app.add_flag("--soup", soup, "Also convert a tube triangle soup with meshToLevelSet");
   app.add_flag("--full", full, "Also run the whole recipe (rasterize, mesh, write STL, re-read, check)");
   app.add_option("--threads", threads, "Worker threads (default all)");
+  app.add_flag("--hausdorff", hausdorff, "With --simplify: the sampled one-sided Hausdorff distances both ways");
+  app.add_option("--simplify", simplify_mm, "Also time extraction with simplification to this deviation (mm), and its check");
   app.add_option("--out", out_dir, "Folder for the recipe run's output");
   CLI11_PARSE(app, argc, argv);
   std::unique_ptr<tbb::global_control> limit;
@@ -174,6 +182,40 @@ int run_bench(int argc, char** argv) {
     result["soup_active_voxels"] = via_soup.active_voxel_count();
     result["soup_volume_mm3"] = via_soup.voxel_volume_mm3();
     result["soup_over_direct_time"] = soup_s / direct_s;
+  }
+  if (simplify_mm > 0) {
+    auto t3 = std::chrono::steady_clock::now();
+    TriMesh plain = extract_surface(direct);
+    result["extract_seconds"] = seconds_since(t3);
+    result["extract_triangles"] = plain.triangles.size();
+    result["extract_volume_mm3"] = check_mesh(plain).volume_mm3;
+    if (!hausdorff) plain = TriMesh();
+    SimplifyOptions so;
+    so.max_deviation_mm = simplify_mm;
+    SimplifyStats stats;
+    auto t4 = std::chrono::steady_clock::now();
+    TriMesh compact = extract_simplified_surface(direct, so, &stats);
+    result["extract_simplified_seconds"] = seconds_since(t4);
+    result["simplified_triangles"] = compact.triangles.size();
+    result["simplify_regions"] = stats.regions;
+    result["simplify_regions_redone"] = stats.regions_redone;
+    auto t5 = std::chrono::steady_clock::now();
+    MeshCheckReport check = check_mesh(compact);
+    result["simplified_check_seconds"] = seconds_since(t5);
+    result["simplified_valid"] = check.valid();
+    result["simplified_genus"] = check.genus;
+    result["simplified_volume_mm3"] = check.volume_mm3;
+    if (hausdorff) {
+      Vec3d at1, at2;
+      result["hausdorff_simplified_to_extracted_mm"] = sampled_hausdorff_mm(compact, plain, 0, &at1);
+      result["hausdorff_extracted_to_simplified_mm"] = sampled_hausdorff_mm(plain, compact, 0, &at2);
+      result["hausdorff_simplified_to_extracted_at"] = {at1.x, at1.y, at1.z};
+      result["hausdorff_extracted_to_simplified_at"] = {at2.x, at2.y, at2.z};
+      if (getenv("LACUNA_DUMP")) {
+        write_stl("/tmp/plain.stl", plain, "plain");
+        write_stl("/tmp/compact.stl", compact, "compact");
+      }
+    }
   }
   direct = Volume();
 

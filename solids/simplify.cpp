@@ -1,0 +1,1183 @@
+#include "solids/simplify.h"
+
+#include <tbb/parallel_for.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_sort.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numeric>
+
+#include "errors.h"
+#include "solids/exact.h"
+#include "solids/extract.h"
+#include "solids/mesh_distance.h"
+#include "util/progress.h"
+
+namespace lacuna {
+namespace {
+
+constexpr uint32_t kNone = UINT32_MAX;
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDeviationMargin = 0.75;
+
+
+// Sum of weighted squared distances to planes: Q(p) = p'Ap + 2b'p + c, with the total weight w.
+struct Quadric {
+  double a00 = 0, a01 = 0, a02 = 0, a11 = 0, a12 = 0, a22 = 0, b0 = 0, b1 = 0, b2 = 0, c = 0, w = 0;
+
+  // The plane n.x + d = 0 (n of unit length) with weight `weight`.
+  void add_plane(const Vec3d& n, double d, double weight) {
+    a00 += weight * n.x * n.x;
+    a01 += weight * n.x * n.y;
+    a02 += weight * n.x * n.z;
+    a11 += weight * n.y * n.y;
+    a12 += weight * n.y * n.z;
+    a22 += weight * n.z * n.z;
+    b0 += weight * d * n.x;
+    b1 += weight * d * n.y;
+    b2 += weight * d * n.z;
+    c += weight * d * d;
+    w += weight;
+  }
+  Quadric& operator+=(const Quadric& o) {
+    a00 += o.a00, a01 += o.a01, a02 += o.a02, a11 += o.a11, a12 += o.a12, a22 += o.a22;
+    b0 += o.b0, b1 += o.b1, b2 += o.b2, c += o.c, w += o.w;
+    return *this;
+  }
+  // Mean squared distance (mm^2) of p to the planes.
+  double error(const Vec3d& p) const {
+    const double q = p.x * (a00 * p.x + a01 * p.y + a02 * p.z) + p.y * (a01 * p.x + a11 * p.y + a12 * p.z) +
+                     p.z * (a02 * p.x + a12 * p.y + a22 * p.z) + 2 * (b0 * p.x + b1 * p.y + b2 * p.z) + c;
+    return std::max(0.0, q);
+  }
+  // The minimiser on the plane n.p = c (the positions that keep the enclosed volume), pulled
+  // slightly towards m: p = p0 - M^-1 n (n.p0 - c) / (n.M^-1 n), with p0 the unconstrained
+  // minimiser and M the regularised matrix. False when either is too badly conditioned.
+  bool minimiser_on_plane(const Vec3d& m, const Vec3d& n, double c_plane, Vec3d& p) const {
+    Vec3d p0, mn;
+    if (!solve(m, n, p0, mn)) return false;
+    const double denominator = dot(n, mn);
+    if (!(std::fabs(denominator) > 1e-300)) return false;
+    p = p0 - mn * ((dot(n, p0) - c_plane) / denominator);
+    return is_finite(p);
+  }
+  // p = the regularised minimiser, mn = M^-1 n.
+  bool solve(const Vec3d& m, const Vec3d& n, Vec3d& p, Vec3d& mn) const {
+    if (!(w > 0)) return false;
+    const double reg = 1e-3 * w;
+    const double m00 = a00 + reg, m11 = a11 + reg, m22 = a22 + reg;
+    const double c00 = m11 * m22 - a12 * a12, c01 = a02 * a12 - a01 * m22, c02 = a01 * a12 - a02 * m11;
+    const double det = m00 * c00 + a01 * c01 + a02 * c02;
+    if (!(std::fabs(det) > 1e-12 * w * w * w)) return false;
+    const double c11 = m00 * m22 - a02 * a02, c12 = a01 * a02 - m00 * a12, c22 = m00 * m11 - a01 * a01;
+    const double r0 = reg * m.x - b0, r1 = reg * m.y - b1, r2 = reg * m.z - b2;
+    const double inv = 1.0 / det;
+    p = Vec3d{(c00 * r0 + c01 * r1 + c02 * r2) * inv, (c01 * r0 + c11 * r1 + c12 * r2) * inv,
+              (c02 * r0 + c12 * r1 + c22 * r2) * inv};
+    mn = Vec3d{(c00 * n.x + c01 * n.y + c02 * n.z) * inv, (c01 * n.x + c11 * n.y + c12 * n.z) * inv,
+               (c02 * n.x + c12 * n.y + c22 * n.z) * inv};
+    return is_finite(p) && is_finite(mn);
+  }
+  // The unconstrained minimiser, pulled slightly towards `m` so flat and straight stretches have
+  // one; false when the system is too badly conditioned.
+  bool minimiser(const Vec3d& m, Vec3d& p) const {
+    if (!(w > 0)) return false;
+    const double reg = 1e-3 * w;
+    const double m00 = a00 + reg, m11 = a11 + reg, m22 = a22 + reg;
+    const double r0 = reg * m.x - b0, r1 = reg * m.y - b1, r2 = reg * m.z - b2;
+    const double c00 = m11 * m22 - a12 * a12, c01 = a02 * a12 - a01 * m22, c02 = a01 * a12 - a02 * m11;
+    const double det = m00 * c00 + a01 * c01 + a02 * c02;
+    if (!(std::fabs(det) > 1e-12 * w * w * w)) return false;
+    const double c11 = m00 * m22 - a02 * a02, c12 = a01 * a02 - m00 * a12, c22 = m00 * m11 - a01 * a01;
+    p = Vec3d{(c00 * r0 + c01 * r1 + c02 * r2) / det, (c01 * r0 + c11 * r1 + c12 * r2) / det,
+              (c02 * r0 + c12 * r1 + c22 * r2) / det};
+    return is_finite(p);
+  }
+};
+
+Quadric operator+(Quadric a, const Quadric& b) { return a += b; }
+
+void add_triangle_plane(Quadric& q, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+  const Vec3d n = cross(b - a, c - a);
+  const double len = norm(n);
+  if (!(len > 0)) return;
+  const Vec3d unit = n / len;
+  q.add_plane(unit, -dot(unit, a), 1.0);
+}
+
+// Half-edges of a region are numbered 4t + k (k < 3: from corner k to corner k + 1 of triangle t),
+// so finding the triangle and the next corner takes shifts, not divisions.
+constexpr uint32_t kNextCorner[4] = {1, 2, 0, 0};
+constexpr uint32_t kPrevCorner[4] = {2, 0, 1, 0};
+inline uint32_t next_he(uint32_t h) { return (h & ~3u) | kNextCorner[h & 3]; }
+inline uint32_t prev_he(uint32_t h) { return (h & ~3u) | kPrevCorner[h & 3]; }
+inline uint32_t tri_of(uint32_t h) { return h >> 2; }
+
+// An axis-aligned region: the open box (lo, hi) holds the vertices that may move; [lo, hi) decides
+// which region writes a triangle.
+struct RegionBox {
+  Vec3d lo, hi;
+  bool strictly_inside(const Vec3d& p) const {
+    return p.x > lo.x && p.x < hi.x && p.y > lo.y && p.y < hi.y && p.z > lo.z && p.z < hi.z;
+  }
+  bool in_closed(const Vec3d& p) const {
+    return p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z && p.z <= hi.z;
+  }
+  bool in_half_open(const Vec3d& p) const {
+    return p.x >= lo.x && p.x < hi.x && p.y >= lo.y && p.y < hi.y && p.z >= lo.z && p.z < hi.z;
+  }
+};
+
+// A collapse waiting its turn: the edge (keep, drop) and the versions of both ends when it was
+// queued (16 bits are plenty: a stale entry that slips through is only tried, and every test
+// runs again then).
+struct QueueEntry {
+  uint32_t keep, drop;
+  uint16_t keep_version, drop_version;
+};
+
+// Collapses by increasing deviation, in buckets of equal width in deviation (the square root of
+// the quadric error): pushing and popping cost O(1), and within a bucket the last queued goes
+// first, so the order is fixed by the input alone.
+class CollapseQueue {
+ public:
+  static constexpr int kBuckets = 64;
+  void clear() {
+    for (auto& b : buckets_) b.clear();
+    lowest_ = kBuckets;
+  }
+  // `fraction`: deviation over the tolerance, in [0, 1].
+  void push(double fraction, const QueueEntry& e) {
+    const int b = std::min(kBuckets - 1, int(fraction * kBuckets));
+    buckets_[size_t(b)].push_back(e);
+    lowest_ = std::min(lowest_, b);
+  }
+  bool pop(QueueEntry& e) {
+    while (lowest_ < kBuckets && buckets_[size_t(lowest_)].empty()) ++lowest_;
+    if (lowest_ == kBuckets) return false;
+    e = buckets_[size_t(lowest_)].back();
+    buckets_[size_t(lowest_)].pop_back();
+    return true;
+  }
+
+ private:
+  std::array<std::vector<QueueEntry>, kBuckets> buckets_;
+  int lowest_ = kBuckets;
+};
+
+// What one block of the first pass leaves: its vertices (local numbering), the grid-edge key of
+// those on the block's faces, the quadrics of the vertices that moved freely, and its triangles.
+struct BlockResult {
+  std::vector<Vec3d> positions;
+  std::vector<uint64_t> keys;
+  std::vector<Quadric> quadrics;
+  std::vector<uint8_t> has_quadric;
+  std::vector<std::array<uint32_t, 3>> triangles;
+};
+
+// One region's piece of the mesh and the collapses in it. Everything is local: vertices and
+// triangles are renumbered, and only the region's own unlocked vertices are written back.
+//
+// Two ways to guard: `guarded` tests every collapse against every triangle near it (a grid of
+// the region, updated as triangles change); otherwise a collapse is tested against the triangles
+// that share its vertices, and verify() then tests every pair of nearby triangles of the result
+// with exact predicates. A region whose result fails verify() is simplified again, guarded, from
+// its input, so nothing untested leaves it either way; the second way is several times faster and
+// almost never has to redo a region.
+class RegionSimplifier {
+ public:
+  explicit RegionSimplifier(const SimplifyOptions& options) {
+    // Every collapse keeps the new vertex within the deviation of every original plane merged
+    // into it (the quadric is a plain sum of squared distances) and the points it removes within
+    // the deviation of the new fan. Drift over many collapses and the chords between vertices add
+    // a little: at three quarters of the deviation the measured one-sided Hausdorff distances stay
+    // within it (see the simplify tests and the capsule benchmark).
+    max_deviation_ = kDeviationMargin * options.max_deviation_mm;
+    tolerance2_ = max_deviation_ * max_deviation_;
+    cos_normal_ = std::cos(options.max_normal_change_deg * kPi / 180.0);
+  }
+
+  // Loads the given triangles of a global mesh; quadrics of vertices that carry one are taken,
+  // the others summed from their local triangles.
+  void load_global(const RegionBox& box, const std::vector<std::array<uint32_t, 3>>& global_tris,
+                   const std::vector<uint32_t>& tri_ids, const std::vector<Vec3d>& positions,
+                   const std::vector<Quadric>& carried, const std::vector<uint8_t>& has_quadric) {
+    box_ = box;
+    const size_t nt = tri_ids.size();
+    global_vertex_.clear();
+    for (uint32_t t : tri_ids)
+      for (uint32_t v : global_tris[t]) global_vertex_.push_back(v);
+    std::sort(global_vertex_.begin(), global_vertex_.end());
+    global_vertex_.erase(std::unique(global_vertex_.begin(), global_vertex_.end()), global_vertex_.end());
+    const size_t nv = global_vertex_.size();
+    tri_.resize(nt);
+    for (size_t i = 0; i < nt; ++i)
+      for (int k = 0; k < 3; ++k)
+        tri_[i][size_t(k)] = uint32_t(std::lower_bound(global_vertex_.begin(), global_vertex_.end(),
+                                                       global_tris[tri_ids[i]][size_t(k)]) -
+                                      global_vertex_.begin());
+    pos_.resize(nv);
+    quadric_.assign(nv, Quadric());
+    own_quadric_.assign(nv, 0);
+    for (size_t v = 0; v < nv; ++v) {
+      const uint32_t g = global_vertex_[v];
+      pos_[v] = positions[g];
+      if (has_quadric[g]) {
+        quadric_[v] = carried[g];
+        own_quadric_[v] = 1;
+      }
+    }
+    init();
+  }
+
+  // Loads one block of the extracted surface.
+  void load_block(const SurfaceBlock& block) {
+    box_ = RegionBox{block.box_mm.min, block.box_mm.max};
+    global_vertex_.clear();
+    tri_ = block.triangles;
+    pos_ = block.positions_mm;
+    quadric_.assign(pos_.size(), Quadric());
+    own_quadric_.assign(pos_.size(), 0);
+    init();
+  }
+
+  void run(bool guarded) {
+    guarded_ = guarded;
+    if (guarded_) build_grid();
+    queue_.clear();
+    for (uint32_t h = 0; h < opp_.size(); ++h) {
+      const uint32_t g = opp_[h];
+      if (g == kNone || g < h) continue;
+      consider(from(h), to(h));
+    }
+    QueueEntry e;
+    while (queue_.pop(e)) {
+      if (!vertex_alive_[e.keep] || !vertex_alive_[e.drop] || uint16_t(version_[e.keep]) != e.keep_version ||
+          uint16_t(version_[e.drop]) != e.drop_version)
+        continue;
+      if (!collapse(e.keep, e.drop)) continue;
+      ++collapses_;
+      for (uint32_t w : keep_ring_after_) consider(e.keep, w);
+    }
+  }
+
+  // Whether no two live triangles meet other than in the vertices or edge they share: every
+  // pair whose boxes overlap is tested exactly, except pairs sharing a vertex whose fan is a
+  // graph over a coordinate plane.
+  bool verify() {
+    const size_t nv = pos_.size();
+    graph_axis_.assign(nv, kUnknownAxis);
+    for (uint32_t v = 0; v < nv; ++v) {
+      if (!vertex_alive_[v] || corner_[v] == kNone) continue;
+      fan_scratch_.clear();
+      if (walk_fan(v, nullptr, &fan_scratch_))
+        graph_axis_[v] = graph_state(pos_[v], fan_scratch_, [](uint32_t x) { return x; },
+                                     [&](uint32_t x) { return pos_[x]; });
+    }
+    build_grid();
+    for (uint32_t t = 0; t < tri_.size(); ++t) {
+      if (!tri_alive_[t]) continue;
+      const auto& ids = tri_[t];
+      const std::array<Vec3d, 3> tp{pos_[ids[0]], pos_[ids[1]], pos_[ids[2]]};
+      const Box3 tb = tri_box(tp);
+      next_stamp();
+      bool hit = false;
+      for_cells(tb, [&](size_t cell) {
+        if (hit) return;
+        for (const Entry& en : grid_[cell]) {
+          const uint32_t u = en.tri;
+          if (u <= t || stamp_[u] == stamp_now_ || !overlaps(en, tb)) continue;
+          stamp_[u] = stamp_now_;
+          const auto& uids = tri_[u];
+          if (shares_graph_vertex(ids, uids)) continue;
+          if (exact::faces_intersect(tp, ids, {pos_[uids[0]], pos_[uids[1]], pos_[uids[2]]}, uids)) {
+            hit = true;
+            return;
+          }
+        }
+      });
+      if (hit) return false;
+    }
+    return true;
+  }
+
+  // Writes the moved vertices' positions and quadrics back (unlocked ones only: no other region
+  // touches them) and appends the triangles this region owns.
+  void store_global(std::vector<Vec3d>& positions, std::vector<Quadric>& quadrics, std::vector<uint8_t>& has_quadric,
+                    std::vector<std::array<uint32_t, 3>>& out_tris) const {
+    for (size_t v = 0; v < pos_.size(); ++v) {
+      if (locked_[v]) continue;
+      const uint32_t g = global_vertex_[v];
+      positions[g] = pos_[v];
+      quadrics[g] = quadric_[v];
+      has_quadric[g] = 1;
+    }
+    for (size_t i = 0; i < tri_.size(); ++i) {
+      if (!tri_alive_[i]) continue;
+      const auto& t = tri_[i];
+      const Vec3d centroid = (pos_[t[0]] + pos_[t[1]] + pos_[t[2]]) / 3.0;
+      if (!box_.in_half_open(centroid)) continue;
+      out_tris.push_back({global_vertex_[t[0]], global_vertex_[t[1]], global_vertex_[t[2]]});
+    }
+  }
+
+  // The block's surviving vertices (in their local order), keys and triangles.
+  void store_block(const SurfaceBlock& block, BlockResult& out) const {
+    out = BlockResult();
+    std::vector<uint32_t> index(pos_.size(), kNone);
+    for (size_t i = 0; i < tri_.size(); ++i)
+      if (tri_alive_[i])
+        for (uint32_t v : tri_[i]) index[v] = 0;
+    for (size_t v = 0; v < pos_.size(); ++v) {
+      if (index[v] == kNone) continue;
+      index[v] = uint32_t(out.positions.size());
+      out.positions.push_back(pos_[v]);
+      out.keys.push_back(block.keys[v]);
+      out.quadrics.push_back(quadric_[v]);
+      out.has_quadric.push_back(locked_[v] ? 0 : 1);
+    }
+    for (size_t i = 0; i < tri_.size(); ++i)
+      if (tri_alive_[i]) out.triangles.push_back({index[tri_[i][0]], index[tri_[i][1]], index[tri_[i][2]]});
+  }
+
+  uint64_t collapses() const { return collapses_; }
+  uint64_t rejected_by_intersection() const { return rejected_intersection_; }
+
+ private:
+  static constexpr uint8_t kUnknownAxis = 0xff;  // graph_axis_: 2 * axis + (sign < 0), or unknown
+  static constexpr int kMaxCells = 32;           // grid cells per axis of a region
+  struct Entry {
+    float lo[3], hi[3];
+    uint32_t tri, version;
+  };
+
+  uint32_t from(uint32_t h) const { return tri_[h >> 2][h & 3]; }
+  uint32_t to(uint32_t h) const { return tri_[h >> 2][kNextCorner[h & 3]]; }
+
+  // Topology, locks and quadrics of the loaded triangles.
+  void init() {
+    const size_t nt = tri_.size(), nv = pos_.size();
+    tri_alive_.assign(nt, 1);
+    vertex_alive_.assign(nv, 1);
+    version_.assign(nv, 0);
+    degree_.assign(nv, 0);
+    corner_.assign(nv, kNone);
+    graph_axis_.assign(nv, kUnknownAxis);
+    touch_stamp_.assign(nv, 0);
+    touch_state_.assign(nv, kUnknownAxis);
+    touch_checked_.assign(nv, 0);
+    touch_now_ = 0;
+    for (size_t i = 0; i < nt; ++i)
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t v = tri_[i][size_t(k)];
+        ++degree_[v];
+        if (corner_[v] == kNone) corner_[v] = uint32_t(4 * i + size_t(k));
+      }
+    pair_half_edges();
+    compute_locks();
+    for (size_t i = 0; i < nt; ++i) {
+      Quadric q;
+      add_triangle_plane(q, pos_[tri_[i][0]], pos_[tri_[i][1]], pos_[tri_[i][2]]);
+      for (uint32_t v : tri_[i])
+        if (!own_quadric_[v]) quadric_[v] += q;
+    }
+    collapses_ = rejected_intersection_ = 0;
+  }
+
+  // Pairs each half-edge a -> b with the one half-edge b -> a, when the edge has exactly those
+  // two: every half-edge goes into an open-addressing table keyed by (a, b), a repeated key marks
+  // its slot as ambiguous, and each half-edge then looks up (b, a).
+  void pair_half_edges() {
+    const size_t nt = tri_.size();
+    opp_.assign(4 * nt, kNone);
+    size_t capacity = 16;
+    while (capacity < 6 * nt) capacity *= 2;
+    table_keys_.assign(capacity, UINT64_MAX);
+    table_values_.resize(capacity);
+    const size_t mask = capacity - 1;
+    auto slot_of = [&](uint64_t key) {
+      size_t i = size_t((key * 0x9e3779b97f4a7c15ull) >> 20) & mask;
+      while (table_keys_[i] != UINT64_MAX && table_keys_[i] != key) i = (i + 1) & mask;
+      return i;
+    };
+    for (uint32_t t = 0; t < nt; ++t)
+      for (uint32_t k = 0; k < 3; ++k) {
+        const uint32_t h = 4 * t + k, a = from(h), b = to(h);
+        if (a == b) continue;
+        const uint64_t key = (uint64_t(a) << 32) | b;
+        const size_t i = slot_of(key);
+        if (table_keys_[i] == key) {
+          table_values_[i] = kNone;  // two half-edges a -> b: the edge is not manifold
+        } else {
+          table_keys_[i] = key;
+          table_values_[i] = h;
+        }
+      }
+    for (uint32_t t = 0; t < nt; ++t)
+      for (uint32_t k = 0; k < 3; ++k) {
+        const uint32_t h = 4 * t + k, a = from(h), b = to(h);
+        if (a == b) continue;
+        const size_t own = slot_of((uint64_t(a) << 32) | b), back = slot_of((uint64_t(b) << 32) | a);
+        if (table_values_[own] == kNone || table_keys_[back] == UINT64_MAX || table_values_[back] == kNone) continue;
+        opp_[h] = table_values_[back];
+      }
+  }
+
+  // A vertex may move only when it lies strictly inside the open box, every triangle around it
+  // lies in the closed box, and its triangles form one closed fan. Then every triangle a
+  // collapse changes stays in the closed box with a vertex strictly inside, so it can meet
+  // triangles of other regions only in edges and vertices that exist already.
+  void compute_locks() {
+    const size_t nv = pos_.size();
+    locked_.assign(nv, 0);
+    for (size_t v = 0; v < nv; ++v)
+      if (!box_.strictly_inside(pos_[v])) locked_[v] = 1;
+    for (const auto& t : tri_) {
+      if (box_.in_closed(pos_[t[0]]) && box_.in_closed(pos_[t[1]]) && box_.in_closed(pos_[t[2]])) continue;
+      locked_[t[0]] = locked_[t[1]] = locked_[t[2]] = 1;
+    }
+    for (size_t v = 0; v < nv; ++v)
+      if (!locked_[v] && !walk_fan(uint32_t(v), nullptr, nullptr)) locked_[v] = 1;
+  }
+
+  // Walks the fan of v (corners at v, and the vertex each leads to); false when it is not one
+  // closed fan of degree_[v] faces.
+  bool walk_fan(uint32_t v, std::vector<uint32_t>* ring, std::vector<uint32_t>* corners) const {
+    const uint32_t start = corner_[v];
+    if (start == kNone) return false;
+    uint32_t c = start, steps = 0;
+    do {
+      if (ring) ring->push_back(to(c));
+      if (corners) corners->push_back(c);
+      const uint32_t across = opp_[prev_he(c)];
+      if (across == kNone) return false;
+      c = across;
+      if (++steps > degree_[v]) return false;
+    } while (c != start);
+    return steps == degree_[v];
+  }
+
+  static Box3 tri_box(const std::array<Vec3d, 3>& p) {
+    Box3 b;
+    b.min = {std::min({p[0].x, p[1].x, p[2].x}), std::min({p[0].y, p[1].y, p[2].y}), std::min({p[0].z, p[1].z, p[2].z})};
+    b.max = {std::max({p[0].x, p[1].x, p[2].x}), std::max({p[0].y, p[1].y, p[2].y}), std::max({p[0].z, p[1].z, p[2].z})};
+    return b;
+  }
+  static bool overlaps(const Entry& e, const Box3& b) {
+    return !(e.lo[0] > b.max.x || e.hi[0] < b.min.x || e.lo[1] > b.max.y || e.hi[1] < b.min.y || e.lo[2] > b.max.z ||
+             e.hi[2] < b.min.z);
+  }
+
+  void next_stamp() {
+    if (++stamp_now_ == 0) {
+      std::fill(stamp_.begin(), stamp_.end(), 0);
+      stamp_now_ = 1;
+    }
+  }
+
+  // A grid over the region's box holding every live triangle (triangles reaching outside it go
+  // to the border cells).
+  void build_grid() {
+    size_t live = 0;
+    for (uint8_t alive : tri_alive_) live += alive;
+    // About two live triangles per cell of a surface through the box: cells ~ live^(1/2) per axis.
+    cells_ = int(std::clamp(std::sqrt(double(live) / 2.0), 4.0, double(kMaxCells)));
+    const Vec3d size = box_.hi - box_.lo;
+    for (int k = 0; k < 3; ++k) inv_cell_[k] = cells_ / size[k];
+    grid_.resize(size_t(cells_ * cells_ * cells_));
+    for (auto& list : grid_) list.clear();
+    grid_version_.assign(tri_.size(), 0);
+    stamp_.assign(tri_.size(), 0);
+    stamp_now_ = 0;
+    for (uint32_t t = 0; t < tri_.size(); ++t)
+      if (tri_alive_[t]) insert(t);
+  }
+
+  int cell_coord(double v, int k) const {
+    const double c = std::floor((v - box_.lo[k]) * inv_cell_[k]);
+    return int(std::clamp(c, 0.0, double(cells_ - 1)));
+  }
+
+  template <class Visit>
+  void for_cells(const Box3& b, Visit&& visit) const {
+    const int x0 = cell_coord(b.min.x, 0), x1 = cell_coord(b.max.x, 0), y0 = cell_coord(b.min.y, 1),
+              y1 = cell_coord(b.max.y, 1), z0 = cell_coord(b.min.z, 2), z1 = cell_coord(b.max.z, 2);
+    for (int x = x0; x <= x1; ++x)
+      for (int y = y0; y <= y1; ++y)
+        for (int z = z0; z <= z1; ++z) visit(size_t((x * cells_ + y) * cells_ + z));
+  }
+
+  // Lists t, with its box rounded outwards to float, in the cells its box meets; entries of an
+  // earlier version of t go stale: a query skips them, and a list drops them whenever its size
+  // reaches a power of two, so lists stay within twice their live size.
+  void insert(uint32_t t) {
+    const auto& v = tri_[t];
+    const Box3 b = tri_box({pos_[v[0]], pos_[v[1]], pos_[v[2]]});
+    Entry e;
+    for (int k = 0; k < 3; ++k) {
+      e.lo[k] = std::nextafter(float(b.min[k]), -HUGE_VALF);
+      e.hi[k] = std::nextafter(float(b.max[k]), HUGE_VALF);
+    }
+    e.tri = t;
+    e.version = ++grid_version_[t];
+    for_cells(b, [&](size_t c) {
+      std::vector<Entry>& list = grid_[c];
+      if (list.size() >= 64 && (list.size() & (list.size() - 1)) == 0)
+        list.erase(std::remove_if(list.begin(), list.end(),
+                                  [&](const Entry& x) { return !tri_alive_[x.tri] || x.version != grid_version_[x.tri]; }),
+                   list.end());
+      list.push_back(e);
+    });
+  }
+
+  // The position the collapse of (keep, drop) would use before the volume is taken into account:
+  // keep's own when it is locked, else the quadric's minimiser (the midpoint when it has none).
+  Vec3d first_target(uint32_t keep, uint32_t drop, const Quadric& q) const {
+    if (locked_[keep]) return pos_[keep];
+    const Vec3d mid = (pos_[keep] + pos_[drop]) * 0.5;
+    Vec3d target;
+    if (!q.minimiser(mid, target)) target = mid;
+    return target;
+  }
+
+  // Queues the collapse of edge (x, y) if the quadric error at its best position is within the
+  // tolerance (the position that keeps the volume is worked out when the collapse is tried).
+  void consider(uint32_t x, uint32_t y) {
+    if (locked_[x] && locked_[y]) return;
+    uint32_t keep = x, drop = y;
+    if (locked_[x] == 0 && locked_[y] == 0 && y < x) std::swap(keep, drop);  // deterministic choice
+    if (locked_[y]) std::swap(keep, drop);
+    const Quadric q = quadric_[keep] + quadric_[drop];
+    const double error = q.error(first_target(keep, drop, q));
+    if (error > tolerance2_) return;
+    queue_.push(std::sqrt(error / tolerance2_), {keep, drop, uint16_t(version_[keep]), uint16_t(version_[drop])});
+  }
+
+  Vec3d at(uint32_t v, uint32_t keep, const Vec3d& target) const { return v == keep ? target : pos_[v]; }
+
+  // Whether the fan around p, given as corners (centre, next, previous) after `rename` and with
+  // positions from `position`, projects one-to-one onto the coordinate plane orthogonal to axis
+  // k with orientation sign s: then 2k + (s < 0), else kUnknownAxis. The projected faces must all
+  // turn the same way and wind exactly once around p (exact orientations; the winding counts the
+  // steps from below the line through p along the first projected axis to on or above it).
+  template <class Rename, class Position>
+  uint8_t graph_state(const Vec3d& p, const std::vector<uint32_t>& corners, Rename&& rename, Position&& position,
+                      uint8_t preferred = kUnknownAxis) const {
+    if (preferred != kUnknownAxis) {
+      const int k = preferred / 2, i = (k + 1) % 3, j = (k + 2) % 3, sign = (preferred & 1) ? -1 : 1;
+      int crossings = 0;
+      bool ok = true;
+      for (uint32_t c : corners) {
+        const Vec3d a = position(rename(to(c))), b = position(rename(from(prev_he(c))));
+        if (exact::orient2d(p[i], p[j], a[i], a[j], b[i], b[j]) != sign) {
+          ok = false;
+          break;
+        }
+        const bool a_low = a[j] < p[j], b_low = b[j] < p[j];
+        if (sign > 0 ? (a_low && !b_low) : (!a_low && b_low)) ++crossings;
+      }
+      if (ok && crossings == 1) return preferred;
+    }
+    Vec3d normal;
+    for (uint32_t c : corners) {
+      const Vec3d a = position(rename(to(c))), b = position(rename(from(prev_he(c))));
+      normal += cross(a - p, b - p);
+    }
+    const int k = std::fabs(normal.x) >= std::fabs(normal.y) && std::fabs(normal.x) >= std::fabs(normal.z)
+                      ? 0
+                      : (std::fabs(normal.y) >= std::fabs(normal.z) ? 1 : 2);
+    const int i = (k + 1) % 3, j = (k + 2) % 3;
+    const int sign = normal[k] > 0 ? 1 : -1;
+    int crossings = 0;
+    for (uint32_t c : corners) {
+      const Vec3d a = position(rename(to(c))), b = position(rename(from(prev_he(c))));
+      if (exact::orient2d(p[i], p[j], a[i], a[j], b[i], b[j]) != sign) return kUnknownAxis;
+      const bool a_low = a[j] < p[j], b_low = b[j] < p[j];
+      if (sign > 0 ? (a_low && !b_low) : (!a_low && b_low)) ++crossings;
+    }
+    return crossings == 1 ? uint8_t(2 * k + (sign < 0)) : kUnknownAxis;
+  }
+
+  // Whether triangle (v, a, b), counter-clockwise around v, projects with v's cached orientation.
+  static bool keeps_graph(uint8_t state, const Vec3d& v, const Vec3d& a, const Vec3d& b) {
+    const int k = state / 2, i = (k + 1) % 3, j = (k + 2) % 3, sign = (state & 1) ? -1 : 1;
+    return exact::orient2d(v[i], v[j], a[i], a[j], b[i], b[j]) == sign;
+  }
+
+  bool shares_graph_vertex(const std::array<uint32_t, 3>& x, const std::array<uint32_t, 3>& y) const {
+    for (uint32_t v : x)
+      if ((v == y[0] || v == y[1] || v == y[2]) && graph_axis_[v] != kUnknownAxis) return true;
+    return false;
+  }
+
+  // Whether p lies within the deviation of triangle abc (its box first).
+  bool within_deviation(const Vec3d& p, const Vec3d& a, const Vec3d& b, const Vec3d& c) const {
+    const double d = max_deviation_;
+    for (int k = 0; k < 3; ++k)
+      if (p[k] < std::min({a[k], b[k], c[k]}) - d || p[k] > std::max({a[k], b[k], c[k]}) + d) return false;
+    return point_triangle_distance(p, a, b, c) <= d;
+  }
+
+  bool collapse(uint32_t keep, uint32_t drop) {
+    drop_corners_.clear();
+    drop_ring_.clear();
+    if (!walk_fan(drop, &drop_ring_, &drop_corners_)) return false;
+    uint32_t h = kNone;
+    for (uint32_t c : drop_corners_)
+      if (to(c) == keep) h = c;
+    if (h == kNone) return false;
+    const uint32_t g = opp_[h];
+    if (g == kNone) return false;
+    const uint32_t t1 = tri_of(h), t2 = tri_of(g);
+    const uint32_t a = to(next_he(h)), b = to(next_he(g));
+    keep_corners_.clear();
+    keep_ring_.clear();
+    if (!walk_fan(keep, &keep_ring_, &keep_corners_)) return false;
+    // Link condition: keep and drop have exactly a and b as common neighbours.
+    int common = 0;
+    for (uint32_t x : drop_ring_)
+      if (std::find(keep_ring_.begin(), keep_ring_.end(), x) != keep_ring_.end()) {
+        if (x != a && x != b) return false;
+        ++common;
+      }
+    if (common != 2 || a == b) return false;
+    if (degree_[a] < 4 || degree_[b] < 4 || degree_[keep] + degree_[drop] < 7) return false;
+
+    // The new fan of keep: both fans without t1 and t2, drop renamed.
+    new_fan_.clear();
+    for (uint32_t c : keep_corners_)
+      if (tri_of(c) != t1 && tri_of(c) != t2) new_fan_.push_back(c);
+    for (uint32_t c : drop_corners_)
+      if (tri_of(c) != t1 && tri_of(c) != t2) new_fan_.push_back(c);
+    auto rename = [&](uint32_t x) { return x == drop ? keep : x; };
+
+    // A free vertex goes where the quadric is least among the positions that keep the enclosed
+    // volume (the new fan's volume is linear in its position), unless that costs more than the
+    // tolerance; then to the plain minimiser.
+    const Quadric q = quadric_[keep] + quadric_[drop];
+    Vec3d target = first_target(keep, drop, q);
+    if (!locked_[keep]) {
+      const Vec3d mid = (pos_[keep] + pos_[drop]) * 0.5;
+      Vec3d n;
+      double old6 = 0;
+      for (uint32_t c : keep_corners_)
+        old6 += dot(pos_[keep] - mid, cross(pos_[to(c)] - mid, pos_[from(prev_he(c))] - mid));
+      for (uint32_t c : drop_corners_)
+        if (tri_of(c) != t1 && tri_of(c) != t2)
+          old6 += dot(pos_[drop] - mid, cross(pos_[to(c)] - mid, pos_[from(prev_he(c))] - mid));
+      for (uint32_t c : new_fan_) n += cross(pos_[to(c)] - mid, pos_[from(prev_he(c))] - mid);
+      Vec3d volume_target;
+      if (q.minimiser_on_plane(mid, n, old6 + dot(n, mid), volume_target) &&
+          q.error(round_to_float(volume_target)) <= tolerance2_)
+        target = volume_target;
+      target = round_to_float(target);
+      if (!box_.strictly_inside(target) || q.error(target) > tolerance2_) return false;
+    } else if (!box_.strictly_inside(target)) {
+      return false;
+    }
+    const bool keep_moves = target != pos_[keep];
+    // The points that leave the surface (drop, and keep's old place when it moves) stay within
+    // the deviation of the new fan: plane distances alone miss a spike folded into its base.
+    {
+      auto near_new_fan = [&](const Vec3d& point) {
+        for (uint32_t c : new_fan_)
+          if (within_deviation(point, target, at(rename(to(c)), keep, target),
+                               at(rename(from(prev_he(c))), keep, target)))
+            return true;
+        return false;
+      };
+      if (!near_new_fan(pos_[drop]) || (keep_moves && !near_new_fan(pos_[keep]))) return false;
+    }
+
+    // The triangles that change: drop's (renamed), and keep's when keep moves.
+    changed_.clear();
+    changed_ids_.clear();
+    changed_pos_.clear();
+    changed_box_.clear();
+    for (uint32_t c : new_fan_) {
+      const uint32_t t = tri_of(c);
+      const auto& old = tri_[t];
+      const bool of_drop = old[0] == drop || old[1] == drop || old[2] == drop;
+      if (!of_drop && !keep_moves) continue;
+      const std::array<uint32_t, 3> ids{rename(old[0]), rename(old[1]), rename(old[2])};
+      const std::array<Vec3d, 3> p{at(ids[0], keep, target), at(ids[1], keep, target), at(ids[2], keep, target)};
+      if (exact::collinear(p[0], p[1], p[2])) return false;
+      const Vec3d n_old = cross(pos_[old[1]] - pos_[old[0]], pos_[old[2]] - pos_[old[0]]);
+      const Vec3d n_new = cross(p[1] - p[0], p[2] - p[0]);
+      if (dot(n_old, n_new) <= cos_normal_ * norm(n_old) * norm(n_new)) return false;
+      changed_.push_back(t);
+      changed_ids_.push_back(ids);
+      changed_pos_.push_back(p);
+      changed_box_.push_back(tri_box(p));
+    }
+
+    // The new triangles stay near the old surface: each centroid, and the midpoint of every edge
+    // from the new vertex, within the deviation of the old fans (vertex tests alone let a
+    // triangle bridge a concave crease or a sliver).
+    auto near_old_surface = [&](const Vec3d& sample) {
+      for (const std::vector<uint32_t>* fan : {&keep_corners_, &drop_corners_})
+        for (uint32_t c : *fan) {
+          const auto& t = tri_[tri_of(c)];
+          if (within_deviation(sample, pos_[t[0]], pos_[t[1]], pos_[t[2]])) return true;
+        }
+      return false;
+    };
+    for (size_t i = 0; i < changed_.size(); ++i)
+      if (!near_old_surface((changed_pos_[i][0] + changed_pos_[i][1] + changed_pos_[i][2]) / 3.0)) return false;
+    for (uint32_t c : new_fan_)
+      if (!near_old_surface((target + pos_[rename(to(c))]) * 0.5)) return false;
+
+    // Pairs sharing a vertex whose fan is a graph over a coordinate plane meet only in what they
+    // share. keep's new fan is checked whole; a neighbour whose fan was a graph stays one when
+    // its changed triangles keep the orientation: its changed stretch (two triangles) spans the
+    // same angle as before, since both spans lie below a full turn and agree modulo one.
+    const uint8_t keep_state = graph_state(target, new_fan_, rename, [&](uint32_t x) { return at(x, keep, target); },
+                                           graph_axis_[keep] != kUnknownAxis ? graph_axis_[keep] : graph_axis_[drop]);
+    touched_.clear();
+    if (++touch_now_ == 0) {
+      std::fill(touch_stamp_.begin(), touch_stamp_.end(), 0);
+      touch_now_ = 1;
+    }
+    for (size_t i = 0; i < changed_.size(); ++i)
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t w = changed_ids_[i][size_t(k)];
+        if (w == keep) continue;
+        if (touch_stamp_[w] != touch_now_) {
+          touch_stamp_[w] = touch_now_;
+          touched_.push_back(w);
+          touch_state_[w] = graph_axis_[w];
+          if (touch_state_[w] == kUnknownAxis) {
+            // Not known: the whole fan as it will be (without t1 and t2).
+            fan_scratch_.clear();
+            if (walk_fan(w, nullptr, &fan_scratch_)) {
+              fan_scratch_.erase(std::remove_if(fan_scratch_.begin(), fan_scratch_.end(),
+                                                [&](uint32_t c) { return tri_of(c) == t1 || tri_of(c) == t2; }),
+                                 fan_scratch_.end());
+              touch_state_[w] = graph_state(pos_[w], fan_scratch_, rename, [&](uint32_t x) { return at(x, keep, target); });
+            }
+            touch_checked_[w] = 1;  // the whole fan was checked: no triangle to test on its own
+            continue;
+          }
+          touch_checked_[w] = 0;
+        }
+        if (touch_checked_[w] || touch_state_[w] == kUnknownAxis) continue;
+        if (!keeps_graph(touch_state_[w], changed_pos_[i][size_t(k)], changed_pos_[i][size_t((k + 1) % 3)],
+                         changed_pos_[i][size_t((k + 2) % 3)]))
+          touch_state_[w] = kUnknownAxis;
+      }
+    auto verified = [&](uint32_t x) {
+      if (x == keep) return keep_state != kUnknownAxis;
+      return (touch_stamp_[x] == touch_now_ ? touch_state_[x] : graph_axis_[x]) != kUnknownAxis;
+    };
+    auto shares_verified = [&](const std::array<uint32_t, 3>& x, const std::array<uint32_t, 3>& y) {
+      for (uint32_t v : x)
+        if ((v == y[0] || v == y[1] || v == y[2]) && verified(v)) return true;
+      return false;
+    };
+    auto meets = [&](size_t i, const std::array<uint32_t, 3>& ids) {
+      return !shares_verified(changed_ids_[i], ids) &&
+             exact::faces_intersect(changed_pos_[i], changed_ids_[i], {pos_[ids[0]], pos_[ids[1]], pos_[ids[2]]}, ids);
+    };
+    // The changed triangles all hold keep: one graph fan covers every pair of them.
+    for (size_t i = 0; i < changed_.size() && keep_state == kUnknownAxis; ++i)
+      for (size_t j = i + 1; j < changed_.size(); ++j) {
+        if (shares_verified(changed_ids_[i], changed_ids_[j])) continue;
+        if (exact::faces_intersect(changed_pos_[i], changed_ids_[i], changed_pos_[j], changed_ids_[j])) {
+          ++rejected_intersection_;
+          return false;
+        }
+      }
+    next_stamp_for_collapse(t1, t2);
+    bool hit = false;
+    if (guarded_) {
+      // Every live triangle whose box meets a changed one.
+      Box3 all = changed_box_.empty() ? Box3() : changed_box_[0];
+      for (const Box3& cb : changed_box_) {
+        all.min = {std::min(all.min.x, cb.min.x), std::min(all.min.y, cb.min.y), std::min(all.min.z, cb.min.z)};
+        all.max = {std::max(all.max.x, cb.max.x), std::max(all.max.y, cb.max.y), std::max(all.max.z, cb.max.z)};
+      }
+      if (!changed_.empty())
+        for_cells(all, [&](size_t cell) {
+          if (hit) return;
+          auto& list = grid_[cell];
+          for (const Entry& en : list) {
+            const uint32_t u = en.tri;
+            if (!overlaps(en, all) || !tri_alive_[u] || en.version != grid_version_[u] || stamp_[u] == stamp_now_)
+              continue;
+            stamp_[u] = stamp_now_;
+            for (size_t i = 0; i < changed_.size() && !hit; ++i)
+              if (overlaps(en, changed_box_[i]) && meets(i, tri_[u])) hit = true;
+            if (hit) return;
+          }
+        });
+    } else {
+      // The unchanged triangles around every vertex of a changed one that is not covered by a
+      // graph fan; pairs sharing no vertex are left to verify().
+      for (size_t i = 0; i < changed_.size() && !hit; ++i)
+        for (uint32_t x : changed_ids_[i]) {
+          if (verified(x)) continue;
+          fan_scratch_.clear();
+          if (x == keep) {
+            walk_fan(keep, nullptr, &fan_scratch_);
+            walk_fan(drop, nullptr, &fan_scratch_);
+          } else {
+            walk_fan(x, nullptr, &fan_scratch_);
+          }
+          for (uint32_t c : fan_scratch_) {
+            const uint32_t u = tri_of(c);
+            if (stamp_[u] == stamp_now_) continue;  // t1, t2 or a changed one
+            if (meets(i, tri_[u])) {
+              hit = true;
+              break;
+            }
+          }
+          if (hit) break;
+        }
+    }
+    if (hit) {
+      ++rejected_intersection_;
+      return false;
+    }
+
+    // Commit: t1 and t2 go, their outer edges are glued, drop's corners become keep's.
+    const uint32_t h1 = next_he(h), h2 = next_he(h1), g1 = next_he(g), g2 = next_he(g1);
+    const uint32_t o1 = opp_[h1], o2 = opp_[h2], o3 = opp_[g1], o4 = opp_[g2];
+    if (o1 == kNone || o2 == kNone || o3 == kNone || o4 == kNone) return false;
+    opp_[o1] = o2;
+    opp_[o2] = o1;
+    opp_[o3] = o4;
+    opp_[o4] = o3;
+    for (uint32_t x : {h, h1, h2, g, g1, g2}) opp_[x] = kNone;
+    for (uint32_t c : drop_corners_) tri_[tri_of(c)][c & 3] = keep;
+    tri_alive_[t1] = tri_alive_[t2] = 0;
+    vertex_alive_[drop] = 0;
+    corner_[drop] = kNone;
+    corner_[keep] = o2;  // now keep -> a
+    corner_[a] = o1;     // a -> keep
+    corner_[b] = o3;     // b -> keep
+    degree_[keep] = degree_[keep] + degree_[drop] - 4;
+    degree_[a] -= 1;
+    degree_[b] -= 1;
+    pos_[keep] = target;
+    quadric_[keep] += quadric_[drop];
+    ++version_[keep];
+    ++version_[drop];
+    graph_axis_[keep] = keep_state;
+    for (uint32_t w : touched_) graph_axis_[w] = touch_state_[w];
+    if (guarded_)
+      for (uint32_t t : changed_) insert(t);
+    keep_ring_after_.clear();
+    for (uint32_t c : new_fan_) keep_ring_after_.push_back(rename(to(c)));
+    return true;
+  }
+
+  // Stamps t1, t2 and the changed triangles, so the searches skip them.
+  void next_stamp_for_collapse(uint32_t t1, uint32_t t2) {
+    if (stamp_.size() != tri_.size()) stamp_.assign(tri_.size(), 0);
+    next_stamp();
+    stamp_[t1] = stamp_[t2] = stamp_now_;
+    for (uint32_t t : changed_) stamp_[t] = stamp_now_;
+  }
+
+  double tolerance2_ = 0, max_deviation_ = 0, cos_normal_ = 0;
+  bool guarded_ = false;
+  RegionBox box_;
+  std::vector<uint32_t> global_vertex_;
+  std::vector<std::array<uint32_t, 3>> tri_;
+  std::vector<Vec3d> pos_;
+  std::vector<Quadric> quadric_;
+  std::vector<uint8_t> own_quadric_, tri_alive_, vertex_alive_, locked_, graph_axis_;
+  std::vector<uint32_t> version_, degree_, corner_, opp_;
+  std::vector<uint64_t> table_keys_;
+  std::vector<uint32_t> table_values_;
+  CollapseQueue queue_;
+  double inv_cell_[3] = {1, 1, 1};
+  int cells_ = kMaxCells;
+  std::vector<std::vector<Entry>> grid_;
+  std::vector<uint32_t> grid_version_, stamp_;
+  uint32_t stamp_now_ = 0;
+  std::vector<uint32_t> drop_corners_, drop_ring_, keep_corners_, keep_ring_, keep_ring_after_, new_fan_, changed_,
+      touched_, fan_scratch_;
+  std::vector<uint32_t> touch_stamp_;
+  std::vector<uint8_t> touch_state_, touch_checked_;
+  uint32_t touch_now_ = 0;
+  std::vector<Box3> changed_box_;
+  std::vector<std::array<uint32_t, 3>> changed_ids_;
+  std::vector<std::array<Vec3d, 3>> changed_pos_;
+  uint64_t collapses_ = 0, rejected_intersection_ = 0;
+};
+
+// Simplifies one region the fast way and verifies the result; redoes it guarded when the
+// verification finds a crossing. `load` (re)loads the region's input.
+template <class Load>
+void simplify_region(RegionSimplifier& simplifier, Load&& load, SimplifyStats& stats) {
+  load();
+  simplifier.run(false);
+  if (!simplifier.verify()) {
+    ++stats.regions_redone;
+    load();
+    simplifier.run(true);
+  }
+  stats.collapses += simplifier.collapses();
+  stats.rejected_by_intersection += simplifier.rejected_by_intersection();
+}
+
+// One pass over a global mesh: the regions of side `side` whose grid starts at `origin` (at
+// least a region below the mesh) are simplified independently; a triangle belongs to every
+// region whose open box its box meets, and to the region holding its centroid (which is the one
+// that writes it).
+void simplify_pass(std::vector<Vec3d>& positions, std::vector<std::array<uint32_t, 3>>& triangles,
+                   std::vector<Quadric>& quadrics, std::vector<uint8_t>& has_quadric, const Vec3d& origin,
+                   double side, const SimplifyOptions& options, SimplifyStats& stats) {
+  auto boundary = [&](int k, int64_t i) { return origin[k] + double(i) * side; };
+  auto index_of = [&](int k, double v) { return std::max<int64_t>(0, int64_t(std::floor((v - origin[k]) / side))); };
+  auto pack = [](int64_t i, int64_t j, int64_t k) { return (uint64_t(i) << 42) | (uint64_t(j) << 21) | uint64_t(k); };
+  const size_t nt = triangles.size();
+  // (region, triangle) pairs, made per block of triangles and concatenated in order.
+  const size_t blocks = std::max<size_t>(1, std::min<size_t>(64, nt / 65536 + 1));
+  std::vector<std::vector<std::pair<uint64_t, uint32_t>>> parts(blocks);
+  tbb::parallel_for(size_t(0), blocks, [&](size_t block) {
+    auto& out = parts[block];
+    for (size_t t = nt * block / blocks; t < nt * (block + 1) / blocks; ++t) {
+      const auto& tri = triangles[t];
+      const Vec3d &p0 = positions[tri[0]], &p1 = positions[tri[1]], &p2 = positions[tri[2]];
+      const Box3 b{{std::min({p0.x, p1.x, p2.x}), std::min({p0.y, p1.y, p2.y}), std::min({p0.z, p1.z, p2.z})},
+                   {std::max({p0.x, p1.x, p2.x}), std::max({p0.y, p1.y, p2.y}), std::max({p0.z, p1.z, p2.z})}};
+      const Vec3d centroid = (p0 + p1 + p2) / 3.0;
+      int64_t own[3], lo[3], hi[3];
+      for (int k = 0; k < 3; ++k) {
+        own[k] = index_of(k, centroid[k]);
+        // The half-open rule by the exact boundary values.
+        while (own[k] > 0 && centroid[k] < boundary(k, own[k])) --own[k];
+        while (centroid[k] >= boundary(k, own[k] + 1)) ++own[k];
+        lo[k] = std::max<int64_t>(0, index_of(k, b.min[k]) - 1);
+        hi[k] = index_of(k, b.max[k]) + 1;
+      }
+      bool own_listed = false;
+      for (int64_t i = lo[0]; i <= hi[0]; ++i) {
+        if (!(b.min.x < boundary(0, i + 1) && b.max.x > boundary(0, i))) continue;
+        for (int64_t j = lo[1]; j <= hi[1]; ++j) {
+          if (!(b.min.y < boundary(1, j + 1) && b.max.y > boundary(1, j))) continue;
+          for (int64_t k = lo[2]; k <= hi[2]; ++k) {
+            if (!(b.min.z < boundary(2, k + 1) && b.max.z > boundary(2, k))) continue;
+            out.push_back({pack(i, j, k), uint32_t(t)});
+            own_listed = own_listed || (i == own[0] && j == own[1] && k == own[2]);
+          }
+        }
+      }
+      if (!own_listed) out.push_back({pack(own[0], own[1], own[2]), uint32_t(t)});
+    }
+  });
+  std::vector<std::pair<uint64_t, uint32_t>> members;
+  {
+    size_t total = 0;
+    for (const auto& p : parts) total += p.size();
+    members.reserve(total);
+    for (auto& p : parts) {
+      members.insert(members.end(), p.begin(), p.end());
+      std::vector<std::pair<uint64_t, uint32_t>>().swap(p);
+    }
+  }
+  tbb::parallel_sort(members.begin(), members.end());
+  std::vector<size_t> region_start;
+  for (size_t i = 0; i < members.size(); ++i)
+    if (i == 0 || members[i].first != members[i - 1].first) region_start.push_back(i);
+  region_start.push_back(members.size());
+  const size_t regions = region_start.size() - 1;
+
+  std::vector<std::vector<std::array<uint32_t, 3>>> out(regions);
+  std::vector<SimplifyStats> region_stats(regions);
+  Progress progress("simplify", regions);
+  tbb::enumerable_thread_specific<RegionSimplifier> simplifiers(options);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, regions, 1), [&](const tbb::blocked_range<size_t>& range) {
+    RegionSimplifier& simplifier = simplifiers.local();
+    std::vector<uint32_t> ids;
+    for (size_t r = range.begin(); r != range.end(); ++r) {
+      ids.clear();
+      for (size_t i = region_start[r]; i < region_start[r + 1]; ++i) ids.push_back(members[i].second);
+      const uint64_t key = members[region_start[r]].first;
+      const int64_t ri = int64_t(key >> 42), rj = int64_t((key >> 21) & 0x1fffff), rk = int64_t(key & 0x1fffff);
+      const RegionBox box{{boundary(0, ri), boundary(1, rj), boundary(2, rk)},
+                          {boundary(0, ri + 1), boundary(1, rj + 1), boundary(2, rk + 1)}};
+      simplify_region(
+          simplifier, [&] { simplifier.load_global(box, triangles, ids, positions, quadrics, has_quadric); },
+          region_stats[r]);
+      simplifier.store_global(positions, quadrics, has_quadric, out[r]);
+      progress.advance();
+    }
+  });
+  triangles.clear();
+  for (size_t r = 0; r < regions; ++r) {
+    triangles.insert(triangles.end(), out[r].begin(), out[r].end());
+    stats.collapses += region_stats[r].collapses;
+    stats.rejected_by_intersection += region_stats[r].rejected_by_intersection;
+    stats.regions_redone += region_stats[r].regions_redone;
+    ++stats.regions;
+  }
+}
+
+// The vertices the triangles use, renumbered in their order, and the triangles.
+TriMesh compact(const std::vector<Vec3d>& positions, const std::vector<std::array<uint32_t, 3>>& triangles) {
+  TriMesh out;
+  std::vector<uint32_t> index(positions.size(), kNone);
+  for (const auto& t : triangles)
+    for (uint32_t v : t) index[v] = 0;
+  for (size_t v = 0; v < positions.size(); ++v)
+    if (index[v] == 0) {
+      index[v] = uint32_t(out.positions_mm.size());
+      out.positions_mm.push_back(positions[v]);
+    }
+  out.triangles.reserve(triangles.size());
+  for (const auto& t : triangles) out.triangles.push_back({index[t[0]], index[t[1]], index[t[2]]});
+  return out;
+}
+
+void check_options(const SimplifyOptions& options) {
+  if (!(options.max_deviation_mm > 0) || !std::isfinite(options.max_deviation_mm))
+    throw InvalidInput("simplification needs a positive maximum deviation in mm");
+  if (!(options.max_normal_change_deg > 0 && options.max_normal_change_deg <= 180))
+    throw InvalidInput("simplification needs a maximum normal change between 0 and 180 degrees");
+}
+
+}  // namespace
+
+TriMesh simplify_mesh(const TriMesh& mesh, const SimplifyOptions& options, SimplifyStats* stats_out) {
+  check_options(options);
+  SimplifyStats stats;
+  stats.input_triangles = mesh.triangles.size();
+  std::vector<Vec3d> positions(mesh.positions_mm.size());
+  for (size_t v = 0; v < positions.size(); ++v) positions[v] = round_to_float(mesh.positions_mm[v]);
+  std::vector<std::array<uint32_t, 3>> triangles = mesh.triangles;
+  Box3 box;
+  double area = 0;
+  for (const auto& t : triangles) {
+    for (uint32_t v : t) box.expand(positions[v]);
+    area += 0.5 * norm(cross(positions[t[1]] - positions[t[0]], positions[t[2]] - positions[t[0]]));
+  }
+  if (triangles.empty() || box.empty()) {
+    stats.output_triangles = mesh.triangles.size();
+    if (stats_out) *stats_out = stats;
+    return mesh;
+  }
+  // About 20 000 triangles per region: a region of side s holds about s^2 of surface.
+  double side = options.region_mm;
+  if (!(side > 0)) {
+    const double extent = std::max({box.size().x, box.size().y, box.size().z});
+    side = std::clamp(std::sqrt(20000.0 * area / double(triangles.size())), extent / 64, std::max(extent / 2, 1e-9));
+    if (!(side > 0)) side = 1;
+  }
+  std::vector<Quadric> quadrics(positions.size());
+  std::vector<uint8_t> has_quadric(positions.size(), 0);
+  const Vec3d origin = box.min - Vec3d{side, side, side} * 1.25;
+  simplify_pass(positions, triangles, quadrics, has_quadric, origin, side, options, stats);
+  simplify_pass(positions, triangles, quadrics, has_quadric, origin - Vec3d{side, side, side} * 0.5, side, options,
+                stats);
+  TriMesh out = compact(positions, triangles);
+  stats.output_triangles = out.triangles.size();
+  if (stats_out) *stats_out = stats;
+  return out;
+}
+
+TriMesh extract_simplified_surface(const Volume& volume, const SimplifyOptions& options, SimplifyStats* stats_out) {
+  check_options(options);
+  SimplifyStats stats;
+  constexpr int kBlockVoxels = 32;
+  const BlockExtractor extractor(volume, kBlockVoxels);
+  const size_t blocks = extractor.block_count();
+  std::vector<BlockResult> results(blocks);
+  std::vector<SimplifyStats> block_stats(blocks);
+  {
+    Progress progress("mesh", blocks);
+    tbb::enumerable_thread_specific<RegionSimplifier> simplifiers(options);
+    tbb::enumerable_thread_specific<SurfaceBlock> surface_blocks;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, blocks, 1), [&](const tbb::blocked_range<size_t>& range) {
+      RegionSimplifier& simplifier = simplifiers.local();
+      SurfaceBlock& block = surface_blocks.local();
+      for (size_t i = range.begin(); i != range.end(); ++i) {
+        extractor.extract(i, block);
+        block_stats[i].input_triangles = block.triangles.size();
+        if (!block.triangles.empty()) {
+          simplify_region(simplifier, [&] { simplifier.load_block(block); }, block_stats[i]);
+          simplifier.store_block(block, results[i]);
+        }
+        progress.advance();
+      }
+    });
+  }
+  // Global numbering: the blocks' interior vertices in block order, then the vertices on block
+  // faces once per grid edge, in key order.
+  std::vector<uint64_t> first_interior(blocks + 1, 0);
+  size_t boundary_count = 0;
+  for (size_t i = 0; i < blocks; ++i) {
+    size_t interior = 0;
+    for (uint64_t key : results[i].keys) interior += key == kInteriorVertex;
+    first_interior[i + 1] = first_interior[i] + interior;
+    boundary_count += results[i].keys.size() - interior;
+    stats.input_triangles += block_stats[i].input_triangles;
+    stats.collapses += block_stats[i].collapses;
+    stats.rejected_by_intersection += block_stats[i].rejected_by_intersection;
+    stats.regions_redone += block_stats[i].regions_redone;
+    stats.regions += results[i].triangles.empty() ? 0 : 1;
+  }
+  std::vector<uint64_t> boundary_keys;
+  boundary_keys.reserve(boundary_count);
+  for (const BlockResult& r : results)
+    for (uint64_t key : r.keys)
+      if (key != kInteriorVertex) boundary_keys.push_back(key);
+  tbb::parallel_sort(boundary_keys.begin(), boundary_keys.end());
+  boundary_keys.erase(std::unique(boundary_keys.begin(), boundary_keys.end()), boundary_keys.end());
+  const uint64_t total = first_interior[blocks] + boundary_keys.size();
+  if (total >= kNone) throw std::length_error("surface has more than 4 billion vertices");
+  std::vector<Vec3d> positions(total);
+  std::vector<Quadric> quadrics(total);
+  std::vector<uint8_t> has_quadric(total, 0);
+  std::vector<std::vector<std::array<uint32_t, 3>>> block_tris(blocks);
+  tbb::parallel_for(size_t(0), blocks, [&](size_t i) {
+    BlockResult& r = results[i];
+    std::vector<uint32_t> global(r.positions.size());
+    uint64_t next = first_interior[i];
+    for (size_t v = 0; v < r.positions.size(); ++v) {
+      uint64_t g;
+      if (r.keys[v] == kInteriorVertex) {
+        g = next++;
+        quadrics[g] = r.quadrics[v];
+        has_quadric[g] = r.has_quadric[v];
+      } else {
+        g = first_interior[blocks] +
+            uint64_t(std::lower_bound(boundary_keys.begin(), boundary_keys.end(), r.keys[v]) - boundary_keys.begin());
+      }
+      positions[g] = r.positions[v];  // a shared vertex is the same float triple from every block
+      global[v] = uint32_t(g);
+    }
+    block_tris[i].reserve(r.triangles.size());
+    for (const auto& t : r.triangles) block_tris[i].push_back({global[t[0]], global[t[1]], global[t[2]]});
+    r = BlockResult();
+  });
+  std::vector<std::array<uint32_t, 3>> triangles;
+  {
+    size_t n = 0;
+    for (const auto& b : block_tris) n += b.size();
+    triangles.reserve(n);
+    for (auto& b : block_tris) {
+      triangles.insert(triangles.end(), b.begin(), b.end());
+      std::vector<std::array<uint32_t, 3>>().swap(b);
+    }
+  }
+  // Across the block faces: regions of the same size, shifted by half a block.
+  if (!triangles.empty()) {
+    const double side = kBlockVoxels * volume.voxel_size_mm();
+    Box3 box;
+    for (const Vec3d& p : positions) box.expand(p);
+    Vec3d origin;
+    for (int k = 0; k < 3; ++k) origin[k] = (std::floor(box.min[k] / side) - 1.5) * side;
+    simplify_pass(positions, triangles, quadrics, has_quadric, origin, side, options, stats);
+  }
+  TriMesh out = compact(positions, triangles);
+  stats.output_triangles = out.triangles.size();
+  if (stats_out) *stats_out = stats;
+  return out;
+}
+
+}  // namespace lacuna

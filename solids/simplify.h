@@ -1,0 +1,45 @@
+// Guarded simplification of closed surfaces: edge collapses by quadric error, each one tested with
+// exact predicates against the triangles near it before it is taken, so a valid solid stays valid
+// (closed, manifold, outward, free of self-intersections and degenerate faces, same components
+// and genus). Parallel in independent regions with locked borders, then across the borders;
+// identical output for any number of threads.
+#pragma once
+
+#include <cstdint>
+
+#include "geometry.h"
+#include "solids/volume.h"
+
+namespace lacuna {
+
+struct SimplifyOptions {
+  double max_deviation_mm = 0.01;     // bound on the quadric deviation of every merged vertex (mm, > 0)
+  double max_normal_change_deg = 60;  // no collapse turns a face's normal further than this
+  // Side of the independent regions (mm); 0 picks one from the mesh so that each holds a few tens
+  // of thousands of triangles.
+  double region_mm = 0;
+};
+
+struct SimplifyStats {
+  uint64_t input_triangles = 0;
+  uint64_t output_triangles = 0;
+  uint64_t collapses = 0;
+  uint64_t rejected_by_intersection = 0;  // collapses the exact guard refused
+  uint64_t regions = 0;                   // regions simplified (blocks and cross-block regions)
+  uint64_t regions_redone = 0;            // regions whose result failed verification and were redone guarded
+};
+
+// Simplifies a closed mesh to within the deviation. Every coordinate of the result is a float32
+// value (the mesh is written as float32), and every check ran on those coordinates. Vertices on a
+// boundary, a non-manifold edge or a non-manifold vertex never move, so an input that is not a
+// clean closed surface is simplified only where it is one. Throws InvalidInput for a non-positive
+// deviation.
+TriMesh simplify_mesh(const TriMesh& mesh, const SimplifyOptions& options, SimplifyStats* stats = nullptr);
+
+// The surface of the volume (extract_surface's marching tetrahedra), simplified block by block
+// as it is extracted, then across the blocks' faces: the full mesh is never held. Same
+// guarantees as simplify_mesh.
+TriMesh extract_simplified_surface(const Volume& volume, const SimplifyOptions& options,
+                                   SimplifyStats* stats = nullptr);
+
+}  // namespace lacuna

@@ -1,0 +1,207 @@
+// Guarded simplification: every result is a valid solid of the same components and genus, the
+// sampled one-sided Hausdorff distances both ways stay within the deviation asked for, volumes
+// stay at their closed forms, and the result does not depend on the number of threads.
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <cmath>
+
+#include "cifs/library.h"
+#include "cifs/solid_input.h"
+#include "errors.h"
+#include "solids/check.h"
+#include "solids/extract.h"
+#include "solids/mesh_distance.h"
+#include "solids/simplify.h"
+#include "solids/voxelize.h"
+
+namespace lacuna {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+struct Simplified {
+  TriMesh plain, compact;
+  MeshCheckReport plain_report, compact_report;
+  SimplifyStats stats;
+  double to_plain_mm = 0, to_compact_mm = 0;  // sampled one-sided Hausdorff distances
+};
+
+// The plain and the simplified surface of a volume, both checked, and the distances between them
+// (the simplified side sampled inside its larger triangles as well).
+Simplified simplify(const Volume& volume, double deviation_mm) {
+  Simplified s;
+  s.plain = extract_surface(volume);
+  SimplifyOptions options;
+  options.max_deviation_mm = deviation_mm;
+  s.compact = extract_simplified_surface(volume, options, &s.stats);
+  s.plain_report = check_mesh(s.plain);
+  s.compact_report = check_mesh(s.compact);
+  const double h = volume.voxel_size_mm();
+  s.to_plain_mm = sampled_hausdorff_mm(s.compact, s.plain, h * h);
+  s.to_compact_mm = sampled_hausdorff_mm(s.plain, s.compact);
+  return s;
+}
+
+void expect_same_solid_within(const Simplified& s, double deviation_mm) {
+  EXPECT_TRUE(s.plain_report.valid()) << ::testing::PrintToString(s.plain_report.problems());
+  EXPECT_TRUE(s.compact_report.valid()) << ::testing::PrintToString(s.compact_report.problems());
+  EXPECT_EQ(s.compact_report.components, s.plain_report.components);
+  EXPECT_EQ(s.compact_report.genus, s.plain_report.genus);
+  EXPECT_LE(s.to_plain_mm, deviation_mm);
+  EXPECT_LE(s.to_compact_mm, deviation_mm);
+  EXPECT_EQ(s.stats.output_triangles, s.compact.triangles.size());
+  EXPECT_EQ(s.stats.input_triangles, s.plain.triangles.size());
+}
+
+GeometrySet sphere(const Vec3d& c, double r) {
+  GeometrySet set;
+  set.spheres.centers_mm.push_back(c);
+  set.spheres.radii_mm.push_back(r);
+  return set;
+}
+
+TEST(Simplify, SphereKeepsItsVolumeWithinTheDeviation) {
+  const double r = 4, h = 0.1;
+  const Simplified s = simplify(voxelize(sphere({0.013, -0.021, 0.007}, r), VolumeOptions{h, 3.0}), 0.2 * h);
+  expect_same_solid_within(s, 0.2 * h);
+  EXPECT_EQ(s.compact_report.genus, 0);
+  const double exact = 4.0 / 3.0 * kPi * r * r * r;
+  EXPECT_NEAR(s.compact_report.volume_mm3, exact, 0.005 * exact);
+  EXPECT_NEAR(s.compact_report.volume_mm3, s.plain_report.volume_mm3, 0.0005 * exact);
+  EXPECT_LT(s.compact.triangles.size(), s.plain.triangles.size() / 4);
+}
+
+TEST(Simplify, ClosedChainOfCapsulesStaysATorus) {
+  const int n = 300;
+  std::vector<Vec3d> points;
+  for (int i = 0; i <= n; ++i) {
+    const double phi = 2 * kPi * (i % n) / n;
+    const double radius = 8 + 2 * std::sin(5 * phi);
+    points.push_back({radius * std::cos(phi), radius * std::sin(phi), 0.7 * std::sin(3 * phi)});
+  }
+  GeometrySet set;
+  set.tubes.tubes.push_back(Tube{points, {0.6}});
+  const double h = 0.1;
+  const Simplified s = simplify(voxelize(set, VolumeOptions{h, 3.0}), 0.2 * h);
+  expect_same_solid_within(s, 0.2 * h);
+  EXPECT_EQ(s.compact_report.genus, 1);
+  EXPECT_NEAR(s.compact_report.volume_mm3, s.plain_report.volume_mm3, 0.001 * s.plain_report.volume_mm3);
+}
+
+TEST(Simplify, MengerSpongeKeepsGenusAndVolume) {
+  // Level 2 of a 9 mm sponge, faces half a voxel off the grid: genus 81, volume 9^3 (20/27)^2.
+  const double side = 9, h = 1.0 / 9.0;
+  nlohmann::json spec = {{"library", "menger_sponge"}, {"scale", side}, {"translate_mm", {h / 2, h / 2, h / 2}}};
+  const cifs::Cifs menger = cifs::parse_system(spec, "test", "system");
+  const Simplified s = simplify(voxelize(cifs::attractor_geometry(menger, 2, {}), VolumeOptions{h, 3.0}), 0.2 * h);
+  expect_same_solid_within(s, 0.2 * h);
+  EXPECT_EQ(s.compact_report.genus, 81);
+  const double exact = side * side * side * std::pow(20.0 / 27.0, 2);
+  EXPECT_NEAR(s.compact_report.volume_mm3, exact, 0.005 * exact);
+  // Flat faces need few triangles.
+  EXPECT_LT(s.compact.triangles.size(), s.plain.triangles.size() / 10);
+}
+
+TEST(Simplify, CubicLatticeKeepsItsGenus) {
+  // A 2 x 2 x 2 cubic lattice of struts: nodes 3^3 = 27, struts 3 * 2 * 3^2 = 54, so the genus
+  // is struts - nodes + 1 = 28.
+  GeometrySet set;
+  const double period = 2, r = 0.3;
+  for (int a = 0; a <= 2; ++a)
+    for (int b = 0; b <= 2; ++b)
+      for (int axis = 0; axis < 3; ++axis) {
+        Vec3d p0, p1;
+        p0[(axis + 1) % 3] = p1[(axis + 1) % 3] = a * period + 0.011;
+        p0[(axis + 2) % 3] = p1[(axis + 2) % 3] = b * period - 0.007;
+        p0[axis] = 0.003;
+        p1[axis] = 2 * period + 0.003;
+        set.tubes.tubes.push_back(Tube{{p0, p1}, {r}});
+      }
+  const double h = 0.08;
+  const Simplified s = simplify(voxelize(set, VolumeOptions{h, 3.0}), 0.2 * h);
+  expect_same_solid_within(s, 0.2 * h);
+  EXPECT_EQ(s.compact_report.genus, 28);
+  EXPECT_EQ(s.compact_report.components, 1u);
+}
+
+TEST(Simplify, NearlyTouchingSpheresStayApart) {
+  // Two balls a third of a voxel apart, simplified with a deviation of two voxels: collapses that
+  // would push one surface through the other must be refused by the exact guard.
+  const double h = 0.1, r = 2;
+  GeometrySet set = sphere({-r - h / 6, 0.01, 0.02}, r);
+  set.spheres.centers_mm.push_back({r + h / 6, 0.01, 0.02});
+  set.spheres.radii_mm.push_back(r);
+  SimplifyOptions options;
+  options.max_deviation_mm = 2 * h;
+  SimplifyStats stats;
+  const Volume volume = voxelize(set, VolumeOptions{h, 3.0});
+  const TriMesh plain = extract_surface(volume);
+  const MeshCheckReport before = check_mesh(plain);
+  const MeshCheckReport after = check_mesh(extract_simplified_surface(volume, options, &stats));
+  EXPECT_TRUE(after.valid()) << ::testing::PrintToString(after.problems());
+  EXPECT_EQ(after.components, before.components);
+  EXPECT_EQ(after.genus, before.genus);
+}
+
+TEST(Simplify, SameResultForAnyThreadCount) {
+  GeometrySet set = sphere({0.1, 0.2, 0.3}, 3);
+  set.tubes.tubes.push_back(Tube{{{-4, 0, 0}, {4, 1, 0.5}, {4, 4, -1}}, {0.7}});
+  const Volume volume = voxelize(set, VolumeOptions{0.08, 3.0});
+  SimplifyOptions options;
+  options.max_deviation_mm = 0.016;
+  TriMesh one, two;
+  {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+    one = extract_simplified_surface(volume, options);
+  }
+  {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+    two = extract_simplified_surface(volume, options);
+  }
+  ASSERT_EQ(one.triangles.size(), two.triangles.size());
+  EXPECT_EQ(one.triangles, two.triangles);
+  ASSERT_EQ(one.positions_mm.size(), two.positions_mm.size());
+  for (size_t i = 0; i < one.positions_mm.size(); ++i) ASSERT_EQ(one.positions_mm[i], two.positions_mm[i]) << i;
+}
+
+TEST(Simplify, AnyClosedMeshAndItsBoundaryKept) {
+  // A plain mesh (not from blocks) goes through the same guarded regions; every coordinate comes
+  // out as a float32 value.
+  const double h = 0.1;
+  const TriMesh plain = extract_surface(voxelize(sphere({0, 0, 0}, 3), VolumeOptions{h, 3.0}));
+  SimplifyOptions options;
+  options.max_deviation_mm = 0.2 * h;
+  const TriMesh compact = simplify_mesh(plain, options);
+  const MeshCheckReport r = check_mesh(compact);
+  EXPECT_TRUE(r.valid()) << ::testing::PrintToString(r.problems());
+  EXPECT_EQ(r.genus, 0);
+  EXPECT_LT(compact.triangles.size(), plain.triangles.size() / 4);
+  EXPECT_LE(sampled_hausdorff_mm(compact, plain, h * h), 0.2 * h);
+  EXPECT_LE(sampled_hausdorff_mm(plain, compact), 0.2 * h);
+  for (const Vec3d& p : compact.positions_mm)
+    for (int k = 0; k < 3; ++k) ASSERT_EQ(p[k], double(float(p[k])));
+
+  // An open surface: the boundary vertices never move, so the boundary loop comes out unchanged.
+  TriMesh open = plain;
+  std::vector<std::array<uint32_t, 3>> kept;
+  for (const auto& t : open.triangles)
+    if (open.positions_mm[t[0]].z < 1.5 || open.positions_mm[t[1]].z < 1.5 || open.positions_mm[t[2]].z < 1.5)
+      kept.push_back(t);
+  open.triangles = kept;
+  const MeshCheckReport open_before = check_mesh(open);
+  const MeshCheckReport open_after = check_mesh(simplify_mesh(open, options));
+  EXPECT_EQ(open_after.boundary_edges, open_before.boundary_edges);
+  EXPECT_GT(open_before.boundary_edges, 0u);
+}
+
+TEST(Simplify, RefusesBadOptions) {
+  SimplifyOptions options;
+  options.max_deviation_mm = 0;
+  EXPECT_THROW(simplify_mesh(TriMesh{}, options), InvalidInput);
+  options.max_deviation_mm = std::nan("");
+  EXPECT_THROW(simplify_mesh(TriMesh{}, options), InvalidInput);
+}
+
+}  // namespace
+}  // namespace lacuna
