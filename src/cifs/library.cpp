@@ -11,6 +11,7 @@
 #include "cifs/nurbs.h"
 #include "errors.h"
 #include "recipe/json_fields.h"
+#include "util/suggest.h"
 
 namespace lacuna {
 namespace cifs {
@@ -316,8 +317,6 @@ NurbsAutomaton parse_nurbs(const JsonObject& o) {
   }
 }
 
-std::string closest_library_name(const std::string& name) { return closest_match(name, library_names()); }
-
 }  // namespace
 
 std::vector<std::string> library_names() {
@@ -329,9 +328,7 @@ std::vector<std::string> library_names() {
 Cifs library_system(const std::string& name) {
   auto it = library().find(name);
   if (it == library().end()) {
-    std::string suggestion = closest_library_name(name);
-    std::string message = "unknown system \"" + name + "\"";
-    if (!suggestion.empty()) message += "; did you mean \"" + suggestion + "\"?";
+    std::string message = "unknown system \"" + name + "\"" + did_you_mean(name, library_names());
     message += " (shipped:";
     for (const std::string& n : library_names()) message += " " + n;
     throw InvalidInput(message + ")");

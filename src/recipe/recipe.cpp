@@ -16,6 +16,7 @@
 #include "voronoi/recipe_input.h"
 #include "infill/recipe_input.h"
 #include "errors.h"
+#include "util/suggest.h"
 
 namespace lacuna {
 namespace {
@@ -251,9 +252,7 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
     input.type = o.string("type");
     auto type = types().find(input.type);
     if (type == types().end()) {
-      std::string suggestion = closest_match(input.type, input_type_names());
-      std::string message = "unknown input type \"" + input.type + "\"";
-      if (!suggestion.empty()) message += "; did you mean \"" + suggestion + "\"?";
+      std::string message = "unknown input type \"" + input.type + "\"" + did_you_mean(input.type, input_type_names());
       message += " (known types:";
       for (const std::string& t : input_type_names()) message += " " + t;
       o.fail("type", message + ")");
@@ -273,9 +272,8 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
       if (!found) {
         std::vector<std::string> input_names;
         for (const RecipeInput& other : recipe.inputs) input_names.push_back(other.name);
-        std::string suggestion = closest_match(dep, input_names);
         throw InvalidInput(path + ": " + in.json_path + ": \"" + dep + "\" is not another input" +
-                           (suggestion.empty() ? std::string() : "; did you mean \"" + suggestion + "\"?"));
+                           did_you_mean(dep, input_names));
       }
     }
 
@@ -299,10 +297,9 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
       if (k == kinds.end()) {
         std::vector<std::string> known;
         for (const auto& e : kinds) known.push_back(e.first);
-        std::string suggestion = closest_match(kind, known);
+        const std::string hint = did_you_mean(kind, known);
         o.fail("op", "unknown operation \"" + kind + "\"" +
-                         (suggestion.empty() ? std::string("; expected union, difference, intersection, offset or shell")
-                                             : "; did you mean \"" + suggestion + "\"?"));
+                         (hint.empty() ? std::string("; expected union, difference, intersection, offset or shell") : hint));
       }
       op.kind = k->second;
       bool unary = op.kind == RecipeOperation::Kind::kOffset || op.kind == RecipeOperation::Kind::kShell;
@@ -335,9 +332,8 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
       }
       for (const std::string& ref : op.operands) {
         if (names.count(ref)) continue;
-        std::string suggestion = closest_match(ref, std::vector<std::string>(names.begin(), names.end()));
         o.fail(op.kind == RecipeOperation::Kind::kInfill ? "hull" : "of", "\"" + ref + "\" is not an input or an earlier operation" +
-                         (suggestion.empty() ? std::string() : "; did you mean \"" + suggestion + "\"?"));
+                         did_you_mean(ref, std::vector<std::string>(names.begin(), names.end())));
       }
       if (op.kind == RecipeOperation::Kind::kOffset) {
         op.distance_mm = o.number("distance_mm");
@@ -359,9 +355,8 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
     out.json_path = o.path();
     auto known = [&](const std::string& name) {
       if (names.count(name)) return;
-      std::string suggestion = closest_match(name, std::vector<std::string>(names.begin(), names.end()));
       o.fail("of", "\"" + name + "\" is not an input or operation" +
-                       (suggestion.empty() ? std::string() : "; did you mean \"" + suggestion + "\"?"));
+                       did_you_mean(name, std::vector<std::string>(names.begin(), names.end())));
     };
     if (o.required("of").is_array()) {
       // Several objects in one 3MF package.
