@@ -18,11 +18,13 @@
 #include "cli/voronoi_commands.h"
 #include "cli/fea_output.h"
 #include "cli/run_recipe.h"
+#include "cli/terminal_progress.h"
 #include "export/fea.h"
 #include "export/output_files.h"
 #include "solids/decimate.h"
 #include "solids/printability.h"
 #include "solids/volume.h"
+#include "cli/exit_codes.h"
 #include "errors.h"
 #include "export/mesh_io.h"
 #include "export/report.h"
@@ -303,7 +305,9 @@ int run_app(int argc, char** argv) {
     return code == 0 ? kExitOk : kExitBadInput;
   }
 
-  set_progress_enabled(!flags.quiet && isatty(STDERR_FILENO));
+  // Bars only where someone watches: a terminal, without --quiet.
+  TerminalProgress bars;
+  ProgressSinkScope progress(!flags.quiet && isatty(STDERR_FILENO) ? &bars : nullptr);
   std::unique_ptr<tbb::global_control> threads;
   if (flags.threads > 0)
     threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, flags.threads);
@@ -319,15 +323,18 @@ int run_app(int argc, char** argv) {
       if (code >= 0) return code;
     }
     return kExitBadInput;
+  } catch (const InternalError& e) {
+    std::cerr << "lacuna: internal error: " << e.what() << "\n";
+    return exit_code(e);
   } catch (const Error& e) {
     std::cerr << "lacuna: error: " << e.what() << "\n";
-    return e.exit_code();
-  } catch (const std::bad_alloc&) {
+    return exit_code(e);
+  } catch (const std::bad_alloc& e) {
     std::cerr << "lacuna: error: out of memory; use a larger voxel size or a lower --max-memory estimate\n";
-    return kExitResourceLimit;
+    return exit_code(e);
   } catch (const std::exception& e) {
     std::cerr << "lacuna: internal error: " << e.what() << "\n";
-    return kExitInternal;
+    return exit_code(e);
   }
 }
 

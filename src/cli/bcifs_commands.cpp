@@ -12,6 +12,7 @@
 #include "bcifs/realize.h"
 #include "bcifs/recipe_input.h"
 #include "bcifs/topology.h"
+#include "cli/exit_codes.h"
 #include "errors.h"
 #include "recipe/json_fields.h"
 

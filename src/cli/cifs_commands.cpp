@@ -9,6 +9,7 @@
 #include "cifs/library.h"
 #include "cifs/nurbs.h"
 #include "cifs/tessellate.h"
+#include "cli/exit_codes.h"
 #include "errors.h"
 #include "recipe/json_fields.h"
 

@@ -9,6 +9,7 @@
 #include <map>
 #include <set>
 
+#include "cli/exit_codes.h"
 #include "errors.h"
 #include "cli/fea_output.h"
 #include "export/fea.h"
