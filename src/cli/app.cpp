@@ -11,24 +11,23 @@
 #include <new>
 #include <sstream>
 
+#include "cli/bcifs_commands.h"
 #include "cli/cifs_commands.h"
 #include "cli/curve_commands.h"
+#include "cli/exit_codes.h"
 #include "cli/fill_commands.h"
-#include "cli/bcifs_commands.h"
-#include "cli/voronoi_commands.h"
-#include "cli/fea_output.h"
-#include "cli/run_recipe.h"
 #include "cli/terminal_progress.h"
+#include "cli/voronoi_commands.h"
+#include "errors.h"
 #include "export/fea.h"
+#include "export/mesh_io.h"
 #include "export/output_files.h"
+#include "export/report.h"
+#include "pipeline/pipeline.h"
+#include "solids/check.h"
 #include "solids/decimate.h"
 #include "solids/printability.h"
 #include "solids/volume.h"
-#include "cli/exit_codes.h"
-#include "errors.h"
-#include "export/mesh_io.h"
-#include "export/report.h"
-#include "solids/check.h"
 #include "util/progress.h"
 #include "util/system.h"
 
@@ -48,17 +47,17 @@ void add_common(CLI::App* command, CommonFlags& flags) {
 }
 
 int command_run(const std::string& recipe, const RunOptions& options, const CommonFlags& flags) {
-  RunResult result = run_recipe(recipe, options);
-  if (flags.json) std::cout << result.report.dump(2) << "\n";
-  if (result.exit_code != kExitOk) {
+  const RunReport result = run(recipe, options);
+  const nlohmann::json r = to_json(result);
+  if (flags.json) std::cout << r.dump(2) << "\n";
+  if (!result.valid) {
     std::cerr << "lacuna: " << recipe << ": an output failed its checks; nothing was written\n";
-    for (const auto& out : result.report["outputs"])
+    for (const auto& out : r["outputs"])
       for (const auto& problem : out["checks"]["problems"])
         std::cerr << "  " << out["file"].get<std::string>() << ": " << problem.get<std::string>() << "\n";
-    return result.exit_code;
+    return kExitCheckFailed;
   }
   if (!flags.json && !flags.quiet) {
-    const auto& r = result.report;
     std::printf("lacuna: ran %s in %.2f s, peak memory %s\n", recipe.c_str(), r["total_seconds"].get<double>(),
                 format_bytes(r["peak_memory_bytes"].get<uint64_t>()).c_str());
     for (const auto& out : r["outputs"]) {
@@ -195,15 +194,19 @@ int command_fea(const FeaArgs& args, const RunOptions& base, const CommonFlags& 
   if (fs::path(args.input).extension() == ".json") {
     RunOptions options = base;
     options.output_dir = fs::path(path).parent_path().empty() ? "." : fs::path(path).parent_path().string();
-    options.replace_outputs = {out};
     options.write_report = false;
-    RunResult result = run_recipe(args.input, options);
-    if (result.exit_code != kExitOk) {
-      for (const auto& problem : result.report["outputs"][0]["checks"]["problems"])
+    // The recipe's first output's object, as the one tetrahedral output.
+    Recipe recipe = load_recipe(args.input);
+    out.object = recipe.outputs.front().object;
+    recipe.outputs = {out};
+    const RunReport result = run(std::move(recipe), options);
+    const nlohmann::json first = to_json(result.outputs.at(0));
+    if (!result.valid) {
+      for (const auto& problem : first["checks"]["problems"])
         std::cerr << "lacuna: " << path << ": " << problem.get<std::string>() << "\n";
-      return result.exit_code;
+      return kExitCheckFailed;
     }
-    report = result.report["outputs"][0];
+    report = first;
   } else {
     TriMesh surface = read_mesh(args.input);
     if (args.decimate > 0) {
@@ -212,10 +215,10 @@ int command_fea(const FeaArgs& args, const RunOptions& base, const CommonFlags& 
       surface = decimate(surface, d);
     }
     FeaResult fea = make_fea_mesh(surface, out.fea);
-    report = fea_report_json(fea);
+    report = fea_report_json(fea.check);
     report["file"] = path;
-    if (!fea.valid()) {
-      for (const std::string& problem : fea.problems) std::cerr << "lacuna: " << args.input << ": " << problem << "\n";
+    if (!fea.check.valid()) {
+      for (const std::string& problem : fea.check.problems) std::cerr << "lacuna: " << args.input << ": " << problem << "\n";
       if (flags.json) std::cout << report.dump(2) << "\n";
       return kExitCheckFailed;
     }
@@ -248,14 +251,14 @@ int run_app(int argc, char** argv) {
   RunOptions run_options;
   std::string recipe;
   double max_memory_gb = 0;
-  CLI::App* run = app.add_subcommand("run", "Run a recipe: write its outputs and report.json, each output re-read and checked");
-  run->add_option("RECIPE", recipe, "Recipe file (JSON)")->required();
-  run->add_option("-o,--output", run_options.output_dir, "Folder for the outputs (default: <recipe name>-out)");
-  run->add_option("--voxel-size", run_options.voxel_size_mm, "Voxel size in mm, overriding the recipe's")
+  CLI::App* run_command = app.add_subcommand("run", "Run a recipe: write its outputs and report.json, each output re-read and checked");
+  run_command->add_option("RECIPE", recipe, "Recipe file (JSON)")->required();
+  run_command->add_option("-o,--output", run_options.output_dir, "Folder for the outputs (default: <recipe name>-out)");
+  run_command->add_option("--voxel-size", run_options.voxel_size_mm, "Voxel size in mm, overriding the recipe's")
       ->check(CLI::PositiveNumber);
-  run->add_option("--max-memory", max_memory_gb, "Memory budget in GB (default: half of the machine's memory)")
+  run_command->add_option("--max-memory", max_memory_gb, "Memory budget in GB (default: half of the machine's memory)")
       ->check(CLI::PositiveNumber);
-  add_common(run, flags);
+  add_common(run_command, flags);
 
   std::string mesh_path;
   CLI::App* check = app.add_subcommand(
@@ -311,8 +314,10 @@ int run_app(int argc, char** argv) {
   std::unique_ptr<tbb::global_control> threads;
   if (flags.threads > 0)
     threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, flags.threads);
+  run_options.threads = flags.threads;
+  run_options.progress = current_progress_sink();
   try {
-    if (*run) {
+    if (*run_command) {
       run_options.max_memory_bytes = uint64_t(max_memory_gb * 1e9);
       return command_run(recipe, run_options, flags);
     }

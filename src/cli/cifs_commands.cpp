@@ -11,6 +11,7 @@
 #include "cifs/tessellate.h"
 #include "cli/exit_codes.h"
 #include "errors.h"
+#include "recipe/cifs_system.h"
 #include "recipe/json_fields.h"
 
 namespace lacuna {

@@ -2,7 +2,7 @@
 // `lacuna fea`.
 #pragma once
 
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
 
@@ -13,12 +13,17 @@
 
 namespace lacuna {
 
-struct FeaResult {
-  MeshCheckReport surface;       // the surface handed to TetGen
-  TetMesh mesh;
-  TetReport report;
+// What verifying a tetrahedral mesh and its surface found.
+struct TetCheck {
+  MeshCheckReport surface;            // the surface handed to TetGen
+  TetReport report;                   // the tetrahedra
   std::vector<std::string> problems;  // empty when the surface and the tetrahedra passed
   bool valid() const { return problems.empty(); }
+};
+
+struct FeaResult {
+  TetMesh mesh;
+  TetCheck check;
 };
 
 // Checks the surface (it must be a valid solid), tetrahedralizes it with the settings, and
@@ -28,6 +33,6 @@ FeaResult make_fea_mesh(const TriMesh& surface, const FeaSettings& settings,
                         const std::vector<Vec3d>& region_seeds = {});
 
 // The report entry of a tetrahedral output.
-nlohmann::json fea_report_json(const FeaResult& result);
+nlohmann::json fea_report_json(const TetCheck& check);
 
 }  // namespace lacuna

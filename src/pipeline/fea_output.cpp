@@ -1,17 +1,19 @@
-#include "cli/fea_output.h"
+#include "pipeline/fea_output.h"
 
 #include <cmath>
+#include <nlohmann/json.hpp>
 
 #include "export/report.h"
 
 namespace lacuna {
 
 FeaResult make_fea_mesh(const TriMesh& surface, const FeaSettings& settings, const std::vector<Vec3d>& region_seeds) {
-  FeaResult r;
+  FeaResult result;
+  TetCheck& r = result.check;
   r.surface = check_mesh(surface);
   if (!r.surface.valid()) {
     for (const std::string& p : r.surface.problems()) r.problems.push_back("surface: " + p);
-    return r;
+    return result;
   }
   TetOptions options;
   options.max_radius_edge_ratio = settings.quality;
@@ -19,8 +21,8 @@ FeaResult make_fea_mesh(const TriMesh& surface, const FeaSettings& settings, con
   options.max_tet_volume_mm3 = settings.max_tet_volume_mm3;
   options.preserve_surface = settings.preserve_surface;
   options.time_limit_s = settings.time_limit_s;
-  r.mesh = tetrahedralize(surface, options, region_seeds);
-  r.report = tet_report(r.mesh);
+  result.mesh = tetrahedralize(surface, options, region_seeds);
+  r.report = tet_report(result.mesh);
   if (r.report.tets == 0) r.problems.push_back("TetGen produced no tetrahedra");
   if (r.report.inverted_tets) r.problems.push_back(std::to_string(r.report.inverted_tets) + " tetrahedra have no positive volume");
   // A preserved surface bounds exactly the same volume; when TetGen may refine, it can also
@@ -34,10 +36,10 @@ FeaResult make_fea_mesh(const TriMesh& surface, const FeaSettings& settings, con
                          " mm3 differs from the surface's " + std::to_string(expected) + " mm3");
   if (settings.max_tet_volume_mm3 > 0 && r.report.max_tet_volume_mm3 > settings.max_tet_volume_mm3 * (1 + 1e-9))
     r.problems.push_back("a tetrahedron exceeds the volume bound");
-  return r;
+  return result;
 }
 
-nlohmann::json fea_report_json(const FeaResult& r) {
+nlohmann::json fea_report_json(const TetCheck& r) {
   nlohmann::json histogram = nlohmann::json::array();
   for (size_t i = 0; i < r.report.ratio_counts.size(); ++i)
     histogram.push_back({{"below", i < r.report.ratio_bins.size() ? nlohmann::json(r.report.ratio_bins[i]) : nlohmann::json(nullptr)},
