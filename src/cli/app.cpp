@@ -20,14 +20,8 @@
 #include "cli/voronoi_commands.h"
 #include "errors.h"
 #include "export/fea.h"
-#include "export/mesh_io.h"
-#include "export/output_files.h"
 #include "export/report.h"
 #include "pipeline/pipeline.h"
-#include "solids/check.h"
-#include "solids/decimate.h"
-#include "solids/printability.h"
-#include "solids/volume.h"
 #include "util/progress.h"
 #include "util/system.h"
 
@@ -98,52 +92,20 @@ Vec3d parse_direction(const std::string& text) {
 }
 
 int command_check(const std::string& path, const CommonFlags& flags, const PrintArgs& print) {
-  TriMesh mesh = read_mesh(path);
-  MeshCheckReport report = check_mesh(mesh);
-  nlohmann::json j = check_report_json(report);
-  j["file"] = path;
-  bool printable = true;
-  PrintabilityReport pr;
-  if (print.enabled) {
-    if (!report.closed()) throw InvalidInput(path + ": printability needs a closed mesh");
-    // Resolve the smallest size asked about by four voxels, else the part by 300.
-    double h = print.voxel;
-    if (!(h > 0)) {
-      double smallest = HUGE_VAL;
-      for (double v : {print.min_wall, print.min_hole})
-        if (v > 0) smallest = std::min(smallest, v / 4);
-      h = std::isfinite(smallest) ? smallest : norm(report.bounding_box.size()) / 300;
-    }
-    PrintabilityOptions options;
-    options.min_wall_mm = print.min_wall;
-    options.min_hole_mm = print.min_hole;
-    options.build_direction = parse_direction(print.build_dir);
-    options.critical_angle_deg = print.critical_angle;
-    pr = analyze_printability(mesh_to_volume(mesh, VolumeOptions{h, 3.0}), options);
-    j["printability"] = {{"voxel_size_mm", h},
-                         {"trapped_voids", nlohmann::json::array()},
-                         {"thin_walls", nlohmann::json::array()},
-                         {"small_holes", nlohmann::json::array()},
-                         {"overhang_area_mm2", pr.overhang_area_mm2},
-                         {"down_facing_area_mm2", pr.down_facing_area_mm2}};
-    auto list = [&](const char* key, const std::vector<PrintFeature>& features) {
-      for (const PrintFeature& f : features)
-        j["printability"][key].push_back({{"volume_mm3", f.volume_mm3}, {"location", {f.location_mm.x, f.location_mm.y, f.location_mm.z}}});
-    };
-    list("trapped_voids", pr.trapped_voids);
-    list("thin_walls", pr.thin_walls);
-    list("small_holes", pr.small_holes);
-    printable = pr.ok();
-    // Copies at the top level, where scripts look first.
-    j["trapped_voids"] = j["printability"]["trapped_voids"];
-    j["thin_walls"] = j["printability"]["thin_walls"];
-    j["small_holes"] = j["printability"]["small_holes"];
-  }
+  CheckFileOptions options;
+  options.printability = print.enabled;
+  options.min_wall_mm = print.min_wall;
+  options.min_hole_mm = print.min_hole;
+  if (print.enabled) options.build_direction = parse_direction(print.build_dir);
+  options.critical_angle_deg = print.critical_angle;
+  options.voxel_size_mm = print.voxel;
+  const FileCheck result = check_file(path, options);
   if (flags.json) {
-    std::cout << j.dump(2) << "\n";
+    std::cout << to_json(result).dump(2) << "\n";
   } else if (!flags.quiet) {
-    std::cout << path << ":\n" << check_report_text(report);
+    std::cout << path << ":\n" << check_report_text(result.check);
     if (print.enabled) {
+      const PrintabilityReport& pr = result.printability;
       auto show = [](const char* what, const std::vector<PrintFeature>& features) {
         for (const PrintFeature& f : features)
           std::printf("  %s: %.4g mm3 at (%.4g, %.4g, %.4g)\n", what, f.volume_mm3, f.location_mm.x, f.location_mm.y, f.location_mm.z);
@@ -152,10 +114,10 @@ int command_check(const std::string& path, const CommonFlags& flags, const Print
       show("thin wall", pr.thin_walls);
       show("small hole", pr.small_holes);
       std::printf("  overhang %.4g mm2 of %.4g mm2 facing down\n  %s\n", pr.overhang_area_mm2, pr.down_facing_area_mm2,
-                  printable ? "printable" : "NOT PRINTABLE as it is");
+                  pr.ok() ? "printable" : "NOT PRINTABLE as it is");
     }
   }
-  return report.valid() && printable ? kExitOk : kExitCheckFailed;
+  return result.valid() ? kExitOk : kExitCheckFailed;
 }
 
 struct FeaArgs {
@@ -208,26 +170,14 @@ int command_fea(const FeaArgs& args, const RunOptions& base, const CommonFlags& 
     }
     report = first;
   } else {
-    TriMesh surface = read_mesh(args.input);
-    if (args.decimate > 0) {
-      DecimateOptions d;
-      d.max_deviation_mm = args.decimate;
-      surface = decimate(surface, d);
-    }
-    FeaResult fea = make_fea_mesh(surface, out.fea);
-    report = fea_report_json(fea.check);
+    const TetCheck check = write_tetrahedra(args.input, path, out.fea, args.decimate);
+    report = fea_report_json(check);
     report["file"] = path;
-    if (!fea.check.valid()) {
-      for (const std::string& problem : fea.check.problems) std::cerr << "lacuna: " << args.input << ": " << problem << "\n";
+    if (!check.valid()) {
+      for (const std::string& problem : check.problems) std::cerr << "lacuna: " << args.input << ": " << problem << "\n";
       if (flags.json) std::cout << report.dump(2) << "\n";
       return kExitCheckFailed;
     }
-    OutputTransaction transaction;
-    FeaWriteOptions w;
-    w.msh_version_2 = args.msh2;
-    w.quadratic = args.c3d10;
-    write_fea(transaction.stage(path), fea_format_from_path(path), fea.mesh, w);
-    transaction.commit();
   }
   if (flags.json) std::cout << report.dump(2) << "\n";
   else if (!flags.quiet)

@@ -3,7 +3,11 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
+#include "export/fea.h"
+#include "export/mesh_io.h"
+#include "export/output_files.h"
 #include "export/report.h"
+#include "solids/decimate.h"
 
 namespace lacuna {
 
@@ -37,6 +41,25 @@ FeaResult make_fea_mesh(const TriMesh& surface, const FeaSettings& settings, con
   if (settings.max_tet_volume_mm3 > 0 && r.report.max_tet_volume_mm3 > settings.max_tet_volume_mm3 * (1 + 1e-9))
     r.problems.push_back("a tetrahedron exceeds the volume bound");
   return result;
+}
+
+TetCheck write_tetrahedra(const std::string& mesh_path, const std::string& output_path, const FeaSettings& settings,
+                          double decimate_mm) {
+  TriMesh surface = read_mesh(mesh_path);
+  if (decimate_mm > 0) {
+    DecimateOptions d;
+    d.max_deviation_mm = decimate_mm;
+    surface = decimate(surface, d);
+  }
+  FeaResult fea = make_fea_mesh(surface, settings);
+  if (!fea.check.valid()) return fea.check;
+  OutputTransaction transaction;
+  FeaWriteOptions w;
+  w.msh_version_2 = settings.msh_version_2;
+  w.quadratic = settings.quadratic;
+  write_fea(transaction.stage(output_path), fea_format_from_path(output_path), fea.mesh, w);
+  transaction.commit();
+  return fea.check;
 }
 
 nlohmann::json fea_report_json(const TetCheck& r) {

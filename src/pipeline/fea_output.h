@@ -32,6 +32,12 @@ struct FeaResult {
 FeaResult make_fea_mesh(const TriMesh& surface, const FeaSettings& settings,
                         const std::vector<Vec3d>& region_seeds = {});
 
+// Tetrahedralizes the closed mesh in the file `mesh_path` (decimated to `decimate_mm` first when it is
+// > 0) and, when the surface and the tetrahedra pass their checks, writes them to `output_path` (the
+// format from its extension) through a temporary file; nothing is written otherwise.
+TetCheck write_tetrahedra(const std::string& mesh_path, const std::string& output_path, const FeaSettings& settings,
+                          double decimate_mm = 0);
+
 // The report entry of a tetrahedral output.
 nlohmann::json fea_report_json(const TetCheck& check);
 

@@ -14,6 +14,7 @@
 #include <string>
 
 #include "pipeline/build_inputs.h"
+#include "pipeline/check_file.h"
 #include "pipeline/evaluate.h"
 #include "pipeline/fea_output.h"
 #include "pipeline/plan.h"
