@@ -1,7 +1,6 @@
-// The shipped systems, and a system written out as JSON (descriptions are read in recipe/cifs_system.h).
+// The shipped systems (systems described in JSON are read in recipe/cifs_system.h).
 #pragma once
 
-#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -18,10 +17,6 @@ std::vector<std::string> library_names();
 // A shipped system with its default control points (unit size, at the origin). Throws
 // InvalidInput for an unknown name, suggesting the closest.
 Cifs library_system(const std::string& name);
-
-// The automaton and control points as JSON (states with control point counts, primitives,
-// stationary flags and primitive vertices; transitions with matrices; control points).
-nlohmann::json system_json(const Cifs& cifs);
 
 }  // namespace cifs
 }  // namespace lacuna

@@ -278,5 +278,60 @@ Cifs load_system(const std::string& name_or_file) {
   return parse_system(parse_json_text(text.str(), name_or_file), name_or_file, "");
 }
 
+nlohmann::json system_json(const Cifs& c) {
+  const Automaton& a = c.automaton;
+  auto matrix = [](const Eigen::MatrixXd& m) {
+    nlohmann::json rows = nlohmann::json::array();
+    for (Eigen::Index i = 0; i < m.rows(); ++i) {
+      nlohmann::json row = nlohmann::json::array();
+      for (Eigen::Index j = 0; j < m.cols(); ++j) row.push_back(m(i, j));
+      rows.push_back(row);
+    }
+    return rows;
+  };
+  std::vector<int> stationary = stationary_states(a);
+  nlohmann::json states = nlohmann::json::array();
+  for (size_t q = 0; q < a.states.size(); ++q) {
+    const State& s = a.states[q];
+    nlohmann::json fixed = nlohmann::json::array();
+    for (const Transition& t : a.transitions[q])
+      if (t.target == int(q)) {
+        try {
+          Eigen::VectorXd x = fixed_point(t.matrix);
+          fixed.push_back({{"symbol", t.symbol}, {"barycentric", std::vector<double>(x.data(), x.data() + x.size())}});
+        } catch (const InvalidInput&) {
+          fixed.push_back({{"symbol", t.symbol}, {"barycentric", nullptr}});
+        }
+      }
+    states.push_back({{"index", q},
+                      {"name", s.name},
+                      {"control_points", s.control_points},
+                      {"primitive", primitive_name(s.primitive)},
+                      {"stationary", std::find(stationary.begin(), stationary.end(), int(q)) != stationary.end()},
+                      {"fixed_points", fixed},
+                      {"vertices", matrix(s.vertices.transpose())}});
+  }
+  nlohmann::json transitions = nlohmann::json::array();
+  for (size_t q = 0; q < a.states.size(); ++q)
+    for (const Transition& t : a.transitions[q])
+      transitions.push_back({{"from", q}, {"symbol", t.symbol}, {"to", t.target}, {"matrix", matrix(t.matrix)}});
+  nlohmann::json points = nlohmann::json::array();
+  for (Eigen::Index i = 0; i < c.control_points.cols(); ++i) {
+    if (c.rational) {
+      double w = c.control_points(3, i);
+      points.push_back({c.control_points(0, i) / w, c.control_points(1, i) / w, c.control_points(2, i) / w, w});
+    } else {
+      points.push_back({c.control_points(0, i), c.control_points(1, i), c.control_points(2, i)});
+    }
+  }
+  return {{"name", c.name},
+          {"alphabet_size", a.alphabet_size},
+          {"initial", a.initial},
+          {"rational", c.rational},
+          {"states", states},
+          {"transitions", transitions},
+          {"control_points_mm", points}};
+}
+
 }  // namespace cifs
 }  // namespace lacuna

@@ -1,4 +1,5 @@
-// CIFS systems described in JSON (files a user writes, recipe inputs) read into cifs::Cifs.
+// CIFS systems described in JSON (files a user writes, recipe inputs) read into cifs::Cifs, and written
+// back out as JSON.
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -23,6 +24,10 @@ Cifs parse_system(const nlohmann::json& value, const std::string& file, const st
 
 // Reads a system from a JSON file, or takes a library name when `name_or_file` is one.
 Cifs load_system(const std::string& name_or_file);
+
+// The automaton and control points as JSON (states with control point counts, primitives,
+// stationary flags and primitive vertices; transitions with matrices; control points).
+nlohmann::json system_json(const Cifs& cifs);
 
 }  // namespace cifs
 }  // namespace lacuna
