@@ -36,7 +36,7 @@ std::unique_ptr<tbb::global_control> thread_limit(int threads) {
 }  // namespace
 
 RunReport run(const std::string& recipe_path, const RunOptions& options) {
-  ProgressSinkScope progress(options.progress);
+  ProgressSinkScope progress(options.progress ? options.progress : current_progress_sink());
   const auto threads = thread_limit(options.threads);
   StageTimer read;
   read.start("read");
@@ -44,7 +44,7 @@ RunReport run(const std::string& recipe_path, const RunOptions& options) {
 }
 
 RunReport run(Recipe recipe, const RunOptions& options) {
-  ProgressSinkScope progress(options.progress);
+  ProgressSinkScope progress(options.progress ? options.progress : current_progress_sink());
   const auto threads = thread_limit(options.threads);
   StageTimer read;
   read.start("read");

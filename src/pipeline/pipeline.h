@@ -30,7 +30,7 @@ struct RunOptions {
   double voxel_size_mm = 0;          // > 0 overrides the recipe's voxel size
   uint64_t max_memory_bytes = 0;     // 0: half the memory available to the process
   int threads = 0;                   // worker threads for the call; 0: every core
-  ProgressSink* progress = nullptr;  // receives the stages and may cancel them; null: none
+  ProgressSink* progress = nullptr;  // receives the stages and may cancel them; null: the one current on this thread
   bool write_report = true;          // report.json next to the outputs
 };
 
