@@ -14,7 +14,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "cli/run_recipe.h"
+#include "pipeline/pipeline.h"
 #include "solids/check.h"
 #include "solids/extract.h"
 #include "solids/mesh_distance.h"
@@ -230,16 +230,16 @@ int run_bench(int argc, char** argv) {
                              {"outputs", {{{"of", "walk"}, {"file", "capsules.stl"}}}}};
     std::string recipe_path = (fs::path(out_dir) / "capsules.json").string();
     std::ofstream(recipe_path) << recipe.dump();
-    RunOptions run;
-    run.output_dir = (fs::path(out_dir) / "out").string();
+    RunOptions run_options;
+    run_options.output_dir = (fs::path(out_dir) / "out").string();
     auto t2 = std::chrono::steady_clock::now();
-    RunResult r = run_recipe(recipe_path, run);
+    const nlohmann::json r = to_json(run(recipe_path, run_options));
     result["recipe_seconds"] = seconds_since(t2);
-    result["recipe_exit_code"] = r.exit_code;
-    result["recipe_stage_seconds"] = r.report["stage_seconds"];
-    result["recipe_triangles"] = r.report["outputs"][0]["triangles"];
-    result["recipe_valid"] = r.report["valid"];
-    result["recipe_memory_estimate_bytes"] = r.report["memory_estimate_bytes"];
+    result["recipe_exit_code"] = r["valid"].get<bool>() ? 0 : 4;
+    result["recipe_stage_seconds"] = r["stage_seconds"];
+    result["recipe_triangles"] = r["outputs"][0]["triangles"];
+    result["recipe_valid"] = r["valid"];
+    result["recipe_memory_estimate_bytes"] = r["memory_estimate_bytes"];
   }
   result["peak_memory_bytes"] = peak_memory_bytes();
   std::printf("%s\n", result.dump().c_str());

@@ -13,7 +13,8 @@
 #include "cifs/library.h"
 #include "cifs/solid_input.h"
 #include "cifs/tessellate.h"
-#include "cli/run_recipe.h"
+#include "pipeline/pipeline.h"
+#include "recipe/cifs_system.h"
 #include "solids/voxelize.h"
 #include "util/system.h"
 
@@ -57,17 +58,17 @@ int run_bench(int argc, char** argv) {
         {"outputs", {{{"of", "sponge"}, {"file", "menger.stl"}}}}};
     std::string path = (fs::path(out_dir) / "menger.json").string();
     std::ofstream(path) << recipe.dump();
-    RunOptions run;
-    run.output_dir = (fs::path(out_dir) / "out").string();
+    RunOptions run_options;
+    run_options.output_dir = (fs::path(out_dir) / "out").string();
     auto t0 = std::chrono::steady_clock::now();
-    RunResult r = run_recipe(path, run);
+    const nlohmann::json r = to_json(run(path, run_options));
     result["recipe_voxel_size_mm"] = h;
     result["recipe_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    result["recipe_stage_seconds"] = r.report["stage_seconds"];
-    result["recipe_triangles"] = r.report["outputs"][0]["triangles"];
-    result["recipe_voxels"] = r.report["outputs"][0]["voxels"];
-    result["recipe_genus"] = r.report["outputs"][0]["genus"];
-    result["recipe_valid"] = r.report["valid"];
+    result["recipe_stage_seconds"] = r["stage_seconds"];
+    result["recipe_triangles"] = r["outputs"][0]["triangles"];
+    result["recipe_voxels"] = r["outputs"][0]["voxels"];
+    result["recipe_genus"] = r["outputs"][0]["genus"];
+    result["recipe_valid"] = r["valid"];
   }
   result["peak_memory_bytes"] = peak_memory_bytes();
   std::printf("%s\n", result.dump().c_str());

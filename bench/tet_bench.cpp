@@ -1,6 +1,6 @@
-// Benchmark (not a test): TetGen on a checked surface mesh, optionally decimated first.
+// Benchmark (not a test): TetGen on a checked surface mesh, optionally simplified first.
 //
-//   lacuna_tet_bench --mesh FILE [--decimate MM] [--max-tet-volume MM3] [--quality Q]
+//   lacuna_tet_bench --mesh FILE [--simplify MM] [--max-tet-volume MM3] [--quality Q]
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
@@ -8,7 +8,7 @@
 
 #include "export/mesh_io.h"
 #include "solids/check.h"
-#include "solids/decimate.h"
+#include "solids/simplify.h"
 #include "solids/tetrahedralize.h"
 #include "util/system.h"
 
@@ -19,7 +19,7 @@ int run_bench(int argc, char** argv) {
   double deviation = 0;
   TetOptions options;
   app.add_option("--mesh", path, "Closed surface mesh (STL, OBJ, PLY, 3MF)")->required();
-  app.add_option("--decimate", deviation, "Decimate to this deviation in mm first");
+  app.add_option("--simplify", deviation, "Simplify (guarded) to this deviation in mm first");
   app.add_option("--max-tet-volume", options.max_tet_volume_mm3, "Largest tetrahedron in mm3");
   app.add_option("--quality", options.max_radius_edge_ratio, "Radius-edge ratio bound");
   CLI11_PARSE(app, argc, argv);
@@ -29,10 +29,10 @@ int run_bench(int argc, char** argv) {
   result["input_triangles"] = surface.triangles.size();
   if (deviation > 0) {
     auto t0 = std::chrono::steady_clock::now();
-    DecimateOptions d;
-    d.max_deviation_mm = deviation;
-    surface = decimate(surface, d);
-    result["decimate_seconds"] = seconds(t0);
+    SimplifyOptions simplify;
+    simplify.max_deviation_mm = deviation;
+    surface = simplify_mesh(surface, simplify);
+    result["simplify_seconds"] = seconds(t0);
   }
   auto t1 = std::chrono::steady_clock::now();
   MeshCheckReport check = check_mesh(surface);

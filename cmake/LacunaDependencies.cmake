@@ -15,7 +15,6 @@ set(BUILD_SHARED_LIBS "${_lacuna_shared}")
 
 find_package(CGAL REQUIRED)
 include(CGAL_TBB_support)
-find_package(OpenMesh REQUIRED CONFIG)
 find_package(draco REQUIRED CONFIG)
 
 find_path(LIB3MF_INCLUDE_DIR Model/COM/NMR_DLLInterfaces.h PATH_SUFFIXES lib3mf REQUIRED)

@@ -21,7 +21,7 @@ esac
 
 packages=(build-essential cmake ninja-build ccache pkg-config
           libopenvdb-dev libboost-iostreams-dev libcgal-dev libgmp-dev libmpfr-dev libtet1.5-dev
-          libopenmesh-dev libdraco-dev lib3mf-dev libzip-dev libeigen3-dev libtbb-dev
+          libdraco-dev lib3mf-dev libzip-dev libeigen3-dev libtbb-dev
           nlohmann-json3-dev libcli11-dev libgtest-dev)
 if [ "$mode" = test ]; then
   # Real downstream clients the tests run the outputs through.

@@ -9,6 +9,7 @@
 #include "cifs/solid_input.h"
 #include "cifs/tessellate.h"
 #include "errors.h"
+#include "recipe/cifs_system.h"
 #include "solids/check.h"
 #include "solids/extract.h"
 #include "solids/rasterize.h"

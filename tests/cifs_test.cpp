@@ -9,6 +9,7 @@
 #include "cifs/nurbs.h"
 #include "cifs/tessellate.h"
 #include "errors.h"
+#include "recipe/cifs_system.h"
 
 namespace lacuna {
 namespace cifs {

@@ -8,6 +8,7 @@
 #include "curves/curves.h"
 #include "curves/sweep.h"
 #include "errors.h"
+#include "pipeline/build_inputs.h"
 #include "recipe/recipe.h"
 #include "solids/check.h"
 #include "solids/components.h"
@@ -155,8 +156,9 @@ TEST(CurveSolids, RecipeBsplinePatchOfDegreeOneIsThePlane) {
   })";
   Recipe recipe = parse_recipe(text, "patch.json");
   ASSERT_EQ(recipe.inputs.size(), 2u);
-  const TubeSet& a = recipe.inputs[0].name == "patch" ? recipe.inputs[0].geometry.tubes : recipe.inputs[1].geometry.tubes;
-  const TubeSet& b = recipe.inputs[0].name == "patch" ? recipe.inputs[1].geometry.tubes : recipe.inputs[0].geometry.tubes;
+  const BuiltInputs built = build_inputs(recipe);
+  const TubeSet& a = recipe.inputs[0].name == "patch" ? built.inputs[0].geometry.tubes : built.inputs[1].geometry.tubes;
+  const TubeSet& b = recipe.inputs[0].name == "patch" ? built.inputs[1].geometry.tubes : built.inputs[0].geometry.tubes;
   ASSERT_EQ(a.tubes.size(), 2u);
   ASSERT_EQ(b.tubes.size(), 2u);
   for (size_t i = 0; i < 2; ++i) {

@@ -3,11 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <nlohmann/json.hpp>
 
 #include "errors.h"
 #include "fill/fill.h"
-#include "fill/recipe_input.h"
+#include "fill/motif_solids.h"
 #include "fill/wallpaper.h"
+#include "pipeline/build_inputs.h"
 #include "recipe/recipe.h"
 #include "solids/check.h"
 #include "solids/extract.h"
@@ -85,13 +87,14 @@ TEST(FillSolids, PorousBoxPorosityIsThePlacedSphereVolume) {
     "outputs": [{"of": "pores", "file": "p.stl"}]
   })";
   Recipe recipe = parse_recipe(text, "porous.json");
-  const RecipeInput& pores = recipe.inputs[0];
+  const BuiltInput pores = build_inputs(recipe).inputs[0];
+  const nlohmann::json report = to_json(pores.report);
   const SphereSet& s = pores.geometry.spheres;
-  ASSERT_EQ(s.centers_mm.size(), 30u) << pores.report.dump();
-  EXPECT_EQ(pores.report["spheres"], 30);
+  ASSERT_EQ(s.centers_mm.size(), 30u) << report.dump();
+  EXPECT_EQ(report["spheres"], 30);
   double placed = 0;
   for (double r : s.radii_mm) placed += 4.0 / 3.0 * kPi * r * r * r;
-  EXPECT_NEAR(placed / 4096, pores.report["fill_fraction"].get<double>(), 1e-12);
+  EXPECT_NEAR(placed / 4096, report["fill_fraction"].get<double>(), 1e-12);
   const double h = 0.1;
   const MeshCheckReport part = check_mesh(extract_surface(subtract(box({0.05, 0.05, 0.05}, {16.05, 16.05, 16.05}, h),
                                                                    voxelize(pores.geometry, VolumeOptions{h, 3.0}))));
@@ -113,14 +116,15 @@ TEST(FillSolids, BoxOfRotatedCubeInclusionsHasThePlacedVolume) {
     "outputs": [{"of": "cubes", "file": "c.stl"}]
   })";
   Recipe recipe = parse_recipe(text, "cubes.json");
-  const RecipeInput& in = recipe.inputs[0];
+  const BuiltInput in = build_inputs(recipe).inputs[0];
+  const nlohmann::json report = to_json(in.report);
   ASSERT_EQ(in.geometry.cells.size(), 1u);
   const ConvexCells& cells = in.geometry.cells[0];
-  ASSERT_EQ(cells.size(), 20u) << in.report.dump();
+  ASSERT_EQ(cells.size(), 20u) << report.dump();
   const double zeta = fill::hurwitz_zeta(1.3, 30);
   double placed = 0;
   for (int i = 0; i < 20; ++i) placed += 1728 / (zeta * std::pow(30.0 + i, 1.3));
-  EXPECT_NEAR(in.report["fill_fraction"].get<double>(), placed / 1728, 1e-12);
+  EXPECT_NEAR(report["fill_fraction"].get<double>(), placed / 1728, 1e-12);
   const MeshCheckReport r = check_mesh(extract_surface(voxelize(in.geometry, VolumeOptions{0.05, 3.0})));
   ASSERT_TRUE(r.valid());
   EXPECT_EQ(r.components, 20u);

@@ -232,11 +232,12 @@ TEST(Infill, ConformingLatticeEndsOnTheInsetSurface) {
   lattice.radius_mm = 0.3;
   lattice.layout = LatticeOptions::Layout::kConforming;
   lattice.conform_inset_mm = inset;
-  lattice.signed_distance_mm = [&](const Vec3d& p) { return norm(p - c) - radius; };
+  HullFields hull;
+  hull.signed_distance_mm = [&](const Vec3d& p) { return norm(p - c) - radius; };
   Box3 region;
   region.expand(c - Vec3d{radius, radius, radius});
   region.expand(c + Vec3d{radius, radius, radius});
-  TubeSet struts = lattice_tubes(region, lattice);
+  TubeSet struts = lattice_tubes(region, lattice, hull);
   ASSERT_GT(struts.tubes.size(), 100u);
   std::map<std::array<long, 3>, size_t> ids;
   std::vector<size_t> parent;

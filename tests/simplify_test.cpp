@@ -8,6 +8,7 @@
 
 #include "cifs/library.h"
 #include "cifs/solid_input.h"
+#include "recipe/cifs_system.h"
 #include "errors.h"
 #include "solids/check.h"
 #include "solids/extract.h"

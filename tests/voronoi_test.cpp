@@ -5,10 +5,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <nlohmann/json.hpp>
 #include <numeric>
 #include <vector>
 
 #include "errors.h"
+#include "pipeline/build_inputs.h"
 #include "recipe/recipe.h"
 #include "voronoi/rules.h"
 #include "voronoi/walls.h"
@@ -375,14 +377,15 @@ TEST(VoronoiSpheres, RecipeInputPlacesOneSpherePerKeptGenerator) {
     "outputs": [{"of": "g", "file": "g.stl"}]
   })";
   Recipe recipe = parse_recipe(text, "spheres.json");
-  const RecipeInput& in = recipe.inputs[0];
+  const BuiltInput in = build_inputs(recipe).inputs[0];
+  const nlohmann::json report = to_json(in.report);
   voronoi::RulesOptions options;
   options.children = voronoi::RulesOptions::Children::kScaled;
   const voronoi::Level level =
       voronoi::generate_level(voronoi::make_rules(2, 2, {{0.86, 0.3}, {0.3, 0.65}, {0.73, 0.85}}, options), 2);
   size_t colour2 = 0;
   for (int c : level.colours) colour2 += c == 1;
-  EXPECT_EQ(in.report["points"], 48);
+  EXPECT_EQ(report["points"], 48);
   ASSERT_EQ(in.geometry.spheres.centers_mm.size(), 2 * colour2);
   for (const Vec3d& p : in.geometry.spheres.centers_mm) {
     EXPECT_GE(p.x, 1);

@@ -7,7 +7,6 @@
 #include "cifs/library.h"
 #include "cifs/tessellate.h"
 #include "errors.h"
-#include "recipe/recipe.h"
 
 namespace lacuna {
 namespace cifs {
@@ -159,46 +158,6 @@ GeometrySet attractor_geometry(const Cifs& cifs_in, int level, const SolidOption
   GeometrySet out;
   out.streams.push_back(std::move(stream));
   return out;
-}
-
-void register_recipe_inputs() {
-  register_input_type(
-      {"cifs",
-       {"system", "level", "as", "radius_mm", "thickness_mm", "fit_to"},
-       [](const JsonObject& o, RecipeInput& in) {
-         Cifs c = parse_system(o.required("system"), o.file(), o.path_of("system"));
-         uint64_t level = o.unsigned_integer_or("level", 3);
-         if (level > 24) o.fail("level", "expected a level from 0 to 24");
-         SolidOptions options;
-         std::string as = o.string_or("as", "");
-         if (as == "tubes") options.as = SolidOptions::As::kTubes;
-         else if (as == "shell") options.as = SolidOptions::As::kShell;
-         else if (as == "cells") options.as = SolidOptions::As::kCells;
-         else if (as == "edges") options.as = SolidOptions::As::kEdges;
-         else if (!as.empty()) o.fail("as", "expected \"tubes\", \"shell\", \"cells\" or \"edges\", got \"" + as + "\"");
-         if (o.has("radius_mm")) options.radius_mm = o.positive_length("radius_mm");
-         if (o.has("thickness_mm")) options.thickness_mm = o.positive_length("thickness_mm");
-         const std::string where = o.file() + ": " + o.path();
-         auto build = [c, level, options, where](const Cifs& placed) {
-           try {
-             return attractor_geometry(placed, int(level), options);
-           } catch (const InvalidInput& e) {
-             throw InvalidInput(where + ": " + e.what());
-           } catch (const ResourceLimit& e) {
-             throw ResourceLimit(where + ": " + e.what());
-           }
-         };
-         if (!o.has("fit_to")) {
-           in.geometry = build(c);
-           return;
-         }
-         // Scaled (uniformly) and moved so the attractor's box fits the other input's, centred.
-         const std::string target = o.string("fit_to");
-         in.depends_on.push_back(target);
-         in.resolve = [c, target, build](RecipeInput& self, const RecipeContext& context) {
-           self.geometry = build(fit_to_box(c, context.box_of(target)));
-         };
-       }});
 }
 
 }  // namespace cifs

@@ -1,4 +1,4 @@
-// CIFS attractors as recipe inputs: curves as tubes, surfaces as shells, volumes as cells, any of
+// CIFS attractors as solids: curves as tubes, surfaces as shells, volumes as cells, any of
 // them as the edges of their pieces; pieces streamed to the solid stage in batches.
 #pragma once
 
@@ -24,9 +24,6 @@ GeometrySet attractor_geometry(const Cifs& cifs, int level, const SolidOptions& 
 
 // The system scaled uniformly and moved so that its attractor's box fits `box`, centred.
 Cifs fit_to_box(const Cifs& cifs, const Box3& box);
-
-// Registers the "cifs" recipe input type (called once by the recipe reader).
-void register_recipe_inputs();
 
 }  // namespace cifs
 }  // namespace lacuna

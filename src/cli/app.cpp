@@ -1,5 +1,6 @@
 #include "cli/app.h"
 
+#include <algorithm>
 #include <tbb/global_control.h>
 #include <unistd.h>
 
@@ -11,22 +12,17 @@
 #include <new>
 #include <sstream>
 
+#include "cli/bcifs_commands.h"
 #include "cli/cifs_commands.h"
 #include "cli/curve_commands.h"
+#include "cli/exit_codes.h"
 #include "cli/fill_commands.h"
-#include "cli/bcifs_commands.h"
+#include "cli/terminal_progress.h"
 #include "cli/voronoi_commands.h"
-#include "cli/fea_output.h"
-#include "cli/run_recipe.h"
-#include "export/fea.h"
-#include "export/output_files.h"
-#include "solids/decimate.h"
-#include "solids/printability.h"
-#include "solids/volume.h"
 #include "errors.h"
-#include "export/mesh_io.h"
+#include "export/fea.h"
 #include "export/report.h"
-#include "solids/check.h"
+#include "pipeline/pipeline.h"
 #include "util/progress.h"
 #include "util/system.h"
 
@@ -46,17 +42,17 @@ void add_common(CLI::App* command, CommonFlags& flags) {
 }
 
 int command_run(const std::string& recipe, const RunOptions& options, const CommonFlags& flags) {
-  RunResult result = run_recipe(recipe, options);
-  if (flags.json) std::cout << result.report.dump(2) << "\n";
-  if (result.exit_code != kExitOk) {
+  const RunReport result = run(recipe, options);
+  const nlohmann::json r = to_json(result);
+  if (flags.json) std::cout << r.dump(2) << "\n";
+  if (!result.valid) {
     std::cerr << "lacuna: " << recipe << ": an output failed its checks; nothing was written\n";
-    for (const auto& out : result.report["outputs"])
+    for (const auto& out : r["outputs"])
       for (const auto& problem : out["checks"]["problems"])
         std::cerr << "  " << out["file"].get<std::string>() << ": " << problem.get<std::string>() << "\n";
-    return result.exit_code;
+    return kExitCheckFailed;
   }
   if (!flags.json && !flags.quiet) {
-    const auto& r = result.report;
     std::printf("lacuna: ran %s in %.2f s, peak memory %s\n", recipe.c_str(), r["total_seconds"].get<double>(),
                 format_bytes(r["peak_memory_bytes"].get<uint64_t>()).c_str());
     for (const auto& out : r["outputs"]) {
@@ -97,52 +93,20 @@ Vec3d parse_direction(const std::string& text) {
 }
 
 int command_check(const std::string& path, const CommonFlags& flags, const PrintArgs& print) {
-  TriMesh mesh = read_mesh(path);
-  MeshCheckReport report = check_mesh(mesh);
-  nlohmann::json j = check_report_json(report);
-  j["file"] = path;
-  bool printable = true;
-  PrintabilityReport pr;
-  if (print.enabled) {
-    if (!report.closed()) throw InvalidInput(path + ": printability needs a closed mesh");
-    // Resolve the smallest size asked about by four voxels, else the part by 300.
-    double h = print.voxel;
-    if (!(h > 0)) {
-      double smallest = HUGE_VAL;
-      for (double v : {print.min_wall, print.min_hole})
-        if (v > 0) smallest = std::min(smallest, v / 4);
-      h = std::isfinite(smallest) ? smallest : norm(report.bounding_box.size()) / 300;
-    }
-    PrintabilityOptions options;
-    options.min_wall_mm = print.min_wall;
-    options.min_hole_mm = print.min_hole;
-    options.build_direction = parse_direction(print.build_dir);
-    options.critical_angle_deg = print.critical_angle;
-    pr = analyze_printability(mesh_to_volume(mesh, VolumeOptions{h, 3.0}), options);
-    j["printability"] = {{"voxel_size_mm", h},
-                         {"trapped_voids", nlohmann::json::array()},
-                         {"thin_walls", nlohmann::json::array()},
-                         {"small_holes", nlohmann::json::array()},
-                         {"overhang_area_mm2", pr.overhang_area_mm2},
-                         {"down_facing_area_mm2", pr.down_facing_area_mm2}};
-    auto list = [&](const char* key, const std::vector<PrintFeature>& features) {
-      for (const PrintFeature& f : features)
-        j["printability"][key].push_back({{"volume_mm3", f.volume_mm3}, {"location", {f.location_mm.x, f.location_mm.y, f.location_mm.z}}});
-    };
-    list("trapped_voids", pr.trapped_voids);
-    list("thin_walls", pr.thin_walls);
-    list("small_holes", pr.small_holes);
-    printable = pr.ok();
-    // Copies at the top level, where scripts look first.
-    j["trapped_voids"] = j["printability"]["trapped_voids"];
-    j["thin_walls"] = j["printability"]["thin_walls"];
-    j["small_holes"] = j["printability"]["small_holes"];
-  }
+  CheckFileOptions options;
+  options.printability = print.enabled;
+  options.min_wall_mm = print.min_wall;
+  options.min_hole_mm = print.min_hole;
+  if (print.enabled) options.build_direction = parse_direction(print.build_dir);
+  options.critical_angle_deg = print.critical_angle;
+  options.voxel_size_mm = print.voxel;
+  const FileCheck result = check_file(path, options);
   if (flags.json) {
-    std::cout << j.dump(2) << "\n";
+    std::cout << to_json(result).dump(2) << "\n";
   } else if (!flags.quiet) {
-    std::cout << path << ":\n" << check_report_text(report);
+    std::cout << path << ":\n" << check_report_text(result.check);
     if (print.enabled) {
+      const PrintabilityReport& pr = result.printability;
       auto show = [](const char* what, const std::vector<PrintFeature>& features) {
         for (const PrintFeature& f : features)
           std::printf("  %s: %.4g mm3 at (%.4g, %.4g, %.4g)\n", what, f.volume_mm3, f.location_mm.x, f.location_mm.y, f.location_mm.z);
@@ -151,10 +115,10 @@ int command_check(const std::string& path, const CommonFlags& flags, const Print
       show("thin wall", pr.thin_walls);
       show("small hole", pr.small_holes);
       std::printf("  overhang %.4g mm2 of %.4g mm2 facing down\n  %s\n", pr.overhang_area_mm2, pr.down_facing_area_mm2,
-                  printable ? "printable" : "NOT PRINTABLE as it is");
+                  pr.ok() ? "printable" : "NOT PRINTABLE as it is");
     }
   }
-  return report.valid() && printable ? kExitOk : kExitCheckFailed;
+  return result.valid() ? kExitOk : kExitCheckFailed;
 }
 
 struct FeaArgs {
@@ -164,7 +128,7 @@ struct FeaArgs {
   double max_tet_volume = 0;
   double quality = 0;
   double min_dihedral = 0;
-  double decimate = 0;
+  double simplify = -1;  // >= 0: simplification deviation (mm); a recipe's own otherwise, none for a mesh file
   bool msh2 = false;
   bool c3d10 = false;
   bool free_surface = false;
@@ -182,7 +146,7 @@ int command_fea(const FeaArgs& args, const RunOptions& base, const CommonFlags& 
   RecipeOutput out;
   out.file = fs::path(path).filename().string();
   out.format = fs::path(path).extension().string().substr(1);
-  out.decimate_mm = args.decimate;
+  if (args.simplify >= 0) out.simplify_mm = args.simplify;
   out.fea.max_tet_volume_mm3 = args.max_tet_volume;
   out.fea.quality = args.quality;
   out.fea.min_dihedral_deg = args.min_dihedral;
@@ -193,36 +157,28 @@ int command_fea(const FeaArgs& args, const RunOptions& base, const CommonFlags& 
   if (fs::path(args.input).extension() == ".json") {
     RunOptions options = base;
     options.output_dir = fs::path(path).parent_path().empty() ? "." : fs::path(path).parent_path().string();
-    options.replace_outputs = {out};
     options.write_report = false;
-    RunResult result = run_recipe(args.input, options);
-    if (result.exit_code != kExitOk) {
-      for (const auto& problem : result.report["outputs"][0]["checks"]["problems"])
+    // The recipe's first output's object, as the one tetrahedral output.
+    Recipe recipe = load_recipe(args.input);
+    out.object = recipe.outputs.front().object;
+    recipe.outputs = {out};
+    const RunReport result = run(std::move(recipe), options);
+    const nlohmann::json first = to_json(result.outputs.at(0));
+    if (!result.valid) {
+      for (const auto& problem : first["checks"]["problems"])
         std::cerr << "lacuna: " << path << ": " << problem.get<std::string>() << "\n";
-      return result.exit_code;
+      return kExitCheckFailed;
     }
-    report = result.report["outputs"][0];
+    report = first;
   } else {
-    TriMesh surface = read_mesh(args.input);
-    if (args.decimate > 0) {
-      DecimateOptions d;
-      d.max_deviation_mm = args.decimate;
-      surface = decimate(surface, d);
-    }
-    FeaResult fea = make_fea_mesh(surface, out.fea);
-    report = fea_report_json(fea);
+    const TetCheck check = write_tetrahedra(args.input, path, out.fea, std::max(0.0, args.simplify));
+    report = fea_report_json(check);
     report["file"] = path;
-    if (!fea.valid()) {
-      for (const std::string& problem : fea.problems) std::cerr << "lacuna: " << args.input << ": " << problem << "\n";
+    if (!check.valid()) {
+      for (const std::string& problem : check.problems) std::cerr << "lacuna: " << args.input << ": " << problem << "\n";
       if (flags.json) std::cout << report.dump(2) << "\n";
       return kExitCheckFailed;
     }
-    OutputTransaction transaction;
-    FeaWriteOptions w;
-    w.msh_version_2 = args.msh2;
-    w.quadratic = args.c3d10;
-    write_fea(transaction.stage(path), fea_format_from_path(path), fea.mesh, w);
-    transaction.commit();
   }
   if (flags.json) std::cout << report.dump(2) << "\n";
   else if (!flags.quiet)
@@ -246,14 +202,18 @@ int run_app(int argc, char** argv) {
   RunOptions run_options;
   std::string recipe;
   double max_memory_gb = 0;
-  CLI::App* run = app.add_subcommand("run", "Run a recipe: write its outputs and report.json, each output re-read and checked");
-  run->add_option("RECIPE", recipe, "Recipe file (JSON)")->required();
-  run->add_option("-o,--output", run_options.output_dir, "Folder for the outputs (default: <recipe name>-out)");
-  run->add_option("--voxel-size", run_options.voxel_size_mm, "Voxel size in mm, overriding the recipe's")
+  CLI::App* run_command = app.add_subcommand("run", "Run a recipe: write its outputs and report.json, each output re-read and checked");
+  run_command->add_option("RECIPE", recipe, "Recipe file (JSON)")->required();
+  run_command->add_option("-o,--output", run_options.output_dir, "Folder for the outputs (default: <recipe name>-out)");
+  run_command->add_option("--voxel-size", run_options.voxel_size_mm, "Voxel size in mm, overriding the recipe's")
       ->check(CLI::PositiveNumber);
-  run->add_option("--max-memory", max_memory_gb, "Memory budget in GB (default: half of the machine's memory)")
+  run_command->add_option("--simplify", run_options.simplify_mm,
+                          "Deviation in mm of the compact meshes written, overriding the recipe's (0: the plain "
+                          "marching-tetrahedra surface; default: a fifth of the voxel)")
+      ->check(CLI::NonNegativeNumber);
+  run_command->add_option("--max-memory", max_memory_gb, "Memory budget in GB (default: half of the machine's memory)")
       ->check(CLI::PositiveNumber);
-  add_common(run, flags);
+  add_common(run_command, flags);
 
   std::string mesh_path;
   CLI::App* check = app.add_subcommand(
@@ -282,8 +242,10 @@ int run_app(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   fea->add_option("--quality", fea_args.quality, "Radius-edge ratio bound, > 1 (e.g. 1.4; default: none)");
   fea->add_option("--min-dihedral", fea_args.min_dihedral, "Smallest dihedral angle to aim for, degrees (with --quality)");
-  fea->add_option("--decimate", fea_args.decimate, "Decimate the surface to this deviation in mm first (re-checked)")
-      ->check(CLI::PositiveNumber);
+  fea->add_option("--simplify,--decimate", fea_args.simplify,
+                  "Simplify the surface to this deviation in mm first, every collapse guarded (0: not at all; default: "
+                  "a recipe's own, none for a mesh file)")
+      ->check(CLI::NonNegativeNumber);
   fea->add_flag("--msh2", fea_args.msh2, "Gmsh format 2.2 instead of 4.1");
   fea->add_flag("--c3d10", fea_args.c3d10, "Quadratic C3D10 elements in .inp (mid-side nodes)");
   fea->add_flag("--free-surface", fea_args.free_surface, "Let TetGen add points on the surface (no -Y)");
@@ -303,12 +265,16 @@ int run_app(int argc, char** argv) {
     return code == 0 ? kExitOk : kExitBadInput;
   }
 
-  set_progress_enabled(!flags.quiet && isatty(STDERR_FILENO));
+  // Bars only where someone watches: a terminal, without --quiet.
+  TerminalProgress bars;
+  ProgressSinkScope progress(!flags.quiet && isatty(STDERR_FILENO) ? &bars : nullptr);
   std::unique_ptr<tbb::global_control> threads;
   if (flags.threads > 0)
     threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, flags.threads);
+  run_options.threads = flags.threads;
+  run_options.progress = current_progress_sink();
   try {
-    if (*run) {
+    if (*run_command) {
       run_options.max_memory_bytes = uint64_t(max_memory_gb * 1e9);
       return command_run(recipe, run_options, flags);
     }
@@ -319,15 +285,18 @@ int run_app(int argc, char** argv) {
       if (code >= 0) return code;
     }
     return kExitBadInput;
+  } catch (const InternalError& e) {
+    std::cerr << "lacuna: internal error: " << e.what() << "\n";
+    return exit_code(e);
   } catch (const Error& e) {
     std::cerr << "lacuna: error: " << e.what() << "\n";
-    return e.exit_code();
-  } catch (const std::bad_alloc&) {
+    return exit_code(e);
+  } catch (const std::bad_alloc& e) {
     std::cerr << "lacuna: error: out of memory; use a larger voxel size or a lower --max-memory estimate\n";
-    return kExitResourceLimit;
+    return exit_code(e);
   } catch (const std::exception& e) {
     std::cerr << "lacuna: internal error: " << e.what() << "\n";
-    return kExitInternal;
+    return exit_code(e);
   }
 }
 

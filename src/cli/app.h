@@ -3,7 +3,7 @@
 
 namespace lacuna {
 
-// Runs the program with the given arguments and returns its exit code (see errors.h).
+// Runs the program with the given arguments and returns its exit code (see cli/exit_codes.h).
 int run_app(int argc, char** argv);
 
 }  // namespace lacuna

@@ -10,9 +10,12 @@
 #include <sstream>
 
 #include "bcifs/realize.h"
-#include "bcifs/recipe_input.h"
+#include "bcifs/plate.h"
 #include "bcifs/topology.h"
+#include "cli/exit_codes.h"
 #include "errors.h"
+#include "pipeline/build_inputs.h"
+#include "recipe/input_parsers.h"
 #include "recipe/json_fields.h"
 
 namespace lacuna {
@@ -99,21 +102,23 @@ int bcifs_measure(const BcifsArgs& a) {
     if (!value.is_object() || value.value("type", "") != "bcifs_plate") continue;
     nlohmann::json object = value;
     object.erase("type");
-    const bcifs::PlateSpec spec = bcifs::parse_plate(JsonObject(object, a.recipe, "inputs." + name));
+    const std::string path = "inputs." + name;
+    const bcifs::Plate plate = build_plate(parse_bcifs_plate_input(JsonObject(object, a.recipe, path)), a.recipe, path);
+    const bcifs::PlateOptions& spec = plate.options;
     nlohmann::json entry;
     nlohmann::json faces = nlohmann::json::array();
     for (size_t f = 0; f < spec.assembly.faces.size(); ++f) {
-      const bcifs::Lacunarity l = bcifs::lacunarity(spec.rules, spec.rules.roots[f], hi);
-      faces.push_back({{"type", spec.rules.roots[f]}, {"subfaces", l.subfaces}, {"lacunas", l.lacunas},
+      const bcifs::Lacunarity l = bcifs::lacunarity(plate.rules, plate.rules.roots[f], hi);
+      faces.push_back({{"type", plate.rules.roots[f]}, {"subfaces", l.subfaces}, {"lacunas", l.lacunas},
                        {"ratio", l.ratio}, {"r_limit", l.limit}, {"spectral_radius", l.spectral_radius}});
     }
     entry["topology"] = faces;
     std::vector<bcifs::Leaf> faces_at_level_0;
-    for (auto& face : bcifs::realize_assembly(spec.rules, spec.assembly, spec.controls, 0, spec.options, spec.bends))
+    for (auto& face : bcifs::realize_assembly(plate.rules, spec.assembly, spec.controls, 0, spec.options, spec.bends))
       faces_at_level_0.insert(faces_at_level_0.end(), face.begin(), face.end());
     std::vector<std::vector<Vec2d>> top_polygons;
     const bcifs::GeometricMeasures m =
-        bcifs::geometric_measures(spec.rules, faces_at_level_0, lo, hi, spec.options, &top_polygons);
+        bcifs::geometric_measures(plate.rules, faces_at_level_0, lo, hi, spec.options, &top_polygons);
     const bcifs::BoxCount region = bcifs::box_count_region(top_polygons);
     const bcifs::BoxCount boundary = bcifs::box_count_segments(bcifs::boundary_segments(top_polygons));
     entry["levels"] = {lo, hi};

@@ -9,7 +9,9 @@
 #include "cifs/library.h"
 #include "cifs/nurbs.h"
 #include "cifs/tessellate.h"
+#include "cli/exit_codes.h"
 #include "errors.h"
+#include "recipe/cifs_system.h"
 #include "recipe/json_fields.h"
 
 namespace lacuna {

@@ -8,6 +8,7 @@
 
 #include "curves/curves.h"
 #include "curves/sweep.h"
+#include "cli/exit_codes.h"
 #include "errors.h"
 
 namespace lacuna {

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "cli/exit_codes.h"
 #include "errors.h"
 #include "fill/fill.h"
 #include "fill/wallpaper.h"

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "cli/exit_codes.h"
 #include "errors.h"
 #include "voronoi/rules.h"
 #include "voronoi/walls.h"

@@ -12,7 +12,7 @@
 
 namespace lacuna {
 
-double GradeField::at(const Vec3d& p) const {
+double GradeField::at(const Vec3d& p, const std::function<double(const Vec3d&)>& depth_of) const {
   switch (kind) {
     case Kind::kNone:
       return 0;
@@ -75,7 +75,7 @@ bool less(const Node& a, const Node& b) { return std::tie(a.i, a.j, a.k) < std::
 
 }  // namespace
 
-TubeSet lattice_tubes(const Box3& box, const LatticeOptions& o) {
+TubeSet lattice_tubes(const Box3& box, const LatticeOptions& o, const HullFields& hull) {
   if (box.empty()) throw InvalidInput("the lattice's box is empty");
   if (!(o.period_mm > 0) || !std::isfinite(o.period_mm)) throw InvalidInput("the lattice period must be positive (mm)");
   const bool radius_graded = o.grade.kind != GradeField::Kind::kNone && o.graded == LatticeOptions::Graded::kRadius;
@@ -86,7 +86,7 @@ TubeSet lattice_tubes(const Box3& box, const LatticeOptions& o) {
     throw InvalidInput("a ramp needs from_mm and to_mm apart");
   if (level_graded && (o.levels < 1 || o.levels > 6)) throw InvalidInput("levels must be 1 to 6");
   const bool conforming = o.layout == LatticeOptions::Layout::kConforming;
-  if (conforming && !o.signed_distance_mm) throw InvalidInput("a conforming lattice needs the hull it conforms to");
+  if (conforming && !hull.signed_distance_mm) throw InvalidInput("a conforming lattice needs the hull it conforms to");
   if (conforming && !(o.conform_inset_mm >= 0)) throw InvalidInput("the conforming inset must be at least 0 (mm)");
 
   // The coarse grid: cells of `cell` mm from `origin`, indices lo..hi-1 on each axis.
@@ -119,7 +119,7 @@ TubeSet lattice_tubes(const Box3& box, const LatticeOptions& o) {
   };
   auto radius = [&](const Vec3d& x) {
     if (!radius_graded) return o.radius_mm;
-    return o.radius_min_mm + (o.radius_max_mm - o.radius_min_mm) * o.grade.at(x);
+    return o.radius_min_mm + (o.radius_max_mm - o.radius_min_mm) * o.grade.at(x, hull.depth_mm);
   };
 
   // Conforming: where each node goes (kept, moved onto the inset surface, or dropped).
@@ -134,11 +134,11 @@ TubeSet lattice_tubes(const Box3& box, const LatticeOptions& o) {
     if (it != placed.end()) return it->second;
     Placed p{position(n), true, false};
     if (conforming) {
-      const double d = o.signed_distance_mm(p.x);
+      const double d = hull.signed_distance_mm(p.x);
       if (d > reach) {
         p.kept = false;
       } else if (d > -o.conform_inset_mm) {
-        p.x = project_to_level(o.signed_distance_mm, p.x, o.conform_inset_mm, 0.05 * reach);
+        p.x = project_to_level(hull.signed_distance_mm, p.x, o.conform_inset_mm, 0.05 * reach);
         p.moved = true;
       }
     }
@@ -170,7 +170,7 @@ TubeSet lattice_tubes(const Box3& box, const LatticeOptions& o) {
   std::function<void(const Node&, int64_t, int)> visit = [&](const Node& c, int64_t size, int level) {
     const int64_t h = size / 2;
     if (level < levels) {
-      const double f = o.grade.at(position(Node{c.i + h, c.j + h, c.k + h}));
+      const double f = o.grade.at(position(Node{c.i + h, c.j + h, c.k + h}), hull.depth_mm);
       if (f > double(level + 1) / double(levels + 1)) {
         for (int q = 0; q < 8; ++q) visit(Node{c.i + (q & 1) * h, c.j + ((q >> 1) & 1) * h, c.k + ((q >> 2) & 1) * h}, h, level + 1);
         return;

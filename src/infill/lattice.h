@@ -18,10 +18,9 @@ struct GradeField {
   std::vector<Vec3d> points_mm;    // points: 1 at a point, falling off as exp(-(d / falloff)^2)
   double falloff_mm = 1;
   double depth_mm = 1;             // depth: 0 at the skin, 1 at this depth inside and beyond
-  std::function<double(const Vec3d&)> depth_of;  // depth: distance inside the hull (mm), set by the runner
 
-  // The field's value at p, in [0, 1].
-  double at(const Vec3d& p) const;
+  // The field's value at p, in [0, 1]; a depth field reads `depth_of` (0 when it is empty).
+  double at(const Vec3d& p, const std::function<double(const Vec3d&)>& depth_of = {}) const;
 };
 
 struct LatticeOptions {
@@ -44,18 +43,23 @@ struct LatticeOptions {
   double radius_max_mm = 0;        // ... and where it is 1
   int levels = 1;                  // level grade: the most splits of a cell
   GradeField grade;
+  double conform_inset_mm = 0;     // kConforming: how deep inside the hull the moved nodes lie
+};
+
+// Fields of the hull a lattice is fitted to, computed by the caller (from the hull's level set).
+struct HullFields {
+  std::function<double(const Vec3d&)> depth_mm;  // depth grades: distance inside the hull (mm, 0 outside)
   // kConforming: the hull's signed distance (mm, negative inside), valid from -conform_inset_mm -
   // period to a period outside. Nodes deeper than conform_inset_mm stay; the others within a
   // period of the hull move to the closest point at that depth; farther ones are dropped with
   // their struts.
   std::function<double(const Vec3d&)> signed_distance_mm;
-  double conform_inset_mm = 0;
 };
 
 // The struts of the cells covering `box`, each split into pieces of at most a quarter period so
 // the radius can follow the field. Throws InvalidInput for non-positive sizes or more than 10^7
-// struts.
-TubeSet lattice_tubes(const Box3& box, const LatticeOptions& options);
+// struts, and for a conforming layout without the hull's signed distance.
+TubeSet lattice_tubes(const Box3& box, const LatticeOptions& options, const HullFields& hull = {});
 
 // The closest point to p where `signed_distance` is -inset (Newton steps along the field's
 // gradient, by central differences of `step_mm`).

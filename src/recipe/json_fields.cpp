@@ -2,28 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <set>
 
 #include "errors.h"
+#include "util/suggest.h"
 
 namespace lacuna {
 namespace {
-
-size_t edit_distance(const std::string& a, const std::string& b) {
-  std::vector<size_t> row(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (size_t i = 1; i <= a.size(); ++i) {
-    size_t diagonal = row[0];
-    row[0] = i;
-    for (size_t j = 1; j <= b.size(); ++j) {
-      size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = up;
-    }
-  }
-  return row[b.size()];
-}
 
 std::string short_value(const nlohmann::json& value) {
   std::string text = value.dump();
@@ -78,23 +63,6 @@ nlohmann::json parse_json_text(const std::string& text, const std::string& file)
   return value;
 }
 
-std::string closest_match(const std::string& word, const std::vector<std::string>& candidates) {
-  std::string best;
-  size_t best_distance = std::numeric_limits<size_t>::max();
-  for (const std::string& c : candidates) {
-    size_t d = edit_distance(word, c);
-    if (d < best_distance) {
-      best_distance = d;
-      best = c;
-    }
-  }
-  // A forgotten unit suffix is the most common slip: "radius" for "radius_mm".
-  for (const std::string& c : candidates)
-    if (c == word + "_mm") return c;
-  size_t tolerance = std::max<size_t>(2, word.size() / 3);
-  return best_distance <= tolerance ? best : std::string();
-}
-
 JsonObject::JsonObject(const nlohmann::json& value, std::string file, std::string path)
     : value_(value), file_(std::move(file)), path_(std::move(path)) {
   if (!value_.is_object())
@@ -116,10 +84,9 @@ void JsonObject::allow_only(std::initializer_list<const char*> allowed) const {
 void JsonObject::allow_only(const std::vector<std::string>& allowed) const {
   for (auto it = value_.begin(); it != value_.end(); ++it) {
     if (std::find(allowed.begin(), allowed.end(), it.key()) != allowed.end()) continue;
-    std::string suggestion = closest_match(it.key(), allowed);
-    std::string message = "unknown key \"" + it.key() + "\"";
-    if (!suggestion.empty()) message += "; did you mean \"" + suggestion + "\"?";
-    else {
+    const std::string hint = did_you_mean(it.key(), allowed);
+    std::string message = "unknown key \"" + it.key() + "\"" + hint;
+    if (hint.empty()) {
       message += "; expected one of:";
       for (const std::string& a : allowed) message += " " + a;
     }

@@ -16,9 +16,6 @@ namespace lacuna {
 // file, line and column on syntax errors.
 nlohmann::json parse_json_text(const std::string& text, const std::string& file);
 
-// The closest candidate to `word` by edit distance, or "" when none is close enough.
-std::string closest_match(const std::string& word, const std::vector<std::string>& candidates);
-
 // One JSON object in a recipe, with its path for messages ("inputs.ball").
 class JsonObject {
  public:

@@ -5,184 +5,89 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <mutex>
 #include <set>
 #include <sstream>
+#include <variant>
 
-#include "bcifs/recipe_input.h"
-#include "cifs/solid_input.h"
-#include "curves/recipe_input.h"
-#include "fill/recipe_input.h"
-#include "voronoi/recipe_input.h"
-#include "infill/recipe_input.h"
 #include "errors.h"
+#include "recipe/input_parsers.h"
+#include "recipe/json_fields.h"
+#include "util/suggest.h"
 
 namespace lacuna {
 namespace {
 
 namespace fs = std::filesystem;
 
-std::map<std::string, InputType>& registry() {
-  static std::map<std::string, InputType> types;
-  return types;
+// How each input type is read: the keys its object may have besides "type", and its parser.
+struct InputType {
+  const char* type;
+  std::vector<std::string> keys;
+  InputSpec (*parse)(const JsonObject& object);
+};
+
+template <class Options, Options (*Parse)(const JsonObject&)>
+InputSpec parse_as(const JsonObject& object) {
+  return Parse(object);
 }
 
-TriMesh inline_mesh(const JsonObject& o) {
-  TriMesh mesh;
-  mesh.positions_mm = o.vec3_list("positions_mm");
-  const nlohmann::json& tris = o.required("triangles");
-  if (!tris.is_array()) o.fail("triangles", "expected a list of [i, j, k] vertex indices");
-  for (size_t t = 0; t < tris.size(); ++t) {
-    const nlohmann::json& tri = tris[t];
-    std::string where = "triangles[" + std::to_string(t) + "]";
-    if (!tri.is_array() || tri.size() != 3) o.fail(where, "expected [i, j, k]");
-    std::array<uint32_t, 3> idx{};
-    for (int k = 0; k < 3; ++k) {
-      if (!tri[k].is_number_integer() || tri[k].get<int64_t>() < 0 ||
-          tri[k].get<uint64_t>() >= mesh.positions_mm.size())
-        o.fail(where, "expected vertex indices from 0 to " + std::to_string(mesh.positions_mm.size()) + " - 1");
-      idx[k] = tri[k].get<uint32_t>();
-    }
-    mesh.triangles.push_back(idx);
-  }
-  if (mesh.triangles.empty()) o.fail("triangles", "expected at least one triangle");
-  return mesh;
+std::vector<std::string> voronoi_keys(std::initializer_list<const char*> more) {
+  std::vector<std::string> keys = {"dimension", "d", "points", "random", "seed", "level", "period_mm", "origin_mm"};
+  keys.insert(keys.end(), more.begin(), more.end());
+  return keys;
 }
 
-// A mesh input: a file to import, or vertices and triangles inline.
-void parse_mesh_source(const JsonObject& o, RecipeInput& in, bool surface) {
-  if (o.has("repair")) {
-    JsonObject r = o.object("repair");
-    r.allow_only({"weld_mm", "reorient", "close_gaps_mm", "allow_overlaps"});
-    in.repair.weld_mm = r.positive_length_or("weld_mm", 0.0);
-    in.repair.reorient = r.boolean_or("reorient", false);
-    in.repair.close_gaps_mm = r.positive_length_or("close_gaps_mm", 0.0);
-    in.repair.allow_overlaps = r.boolean_or("allow_overlaps", false);
-  }
-  bool has_file = o.has("file"), has_inline = o.has("positions_mm") || o.has("triangles");
-  if (has_file == has_inline) o.fail("", "give either \"file\" or \"positions_mm\" and \"triangles\"");
-  in.mesh_scale = o.has("scale") ? o.positive_length("scale") : 1.0;
-  in.mesh_translate_mm = o.vec3_or("translate_mm", Vec3d{});
-  if (surface) in.surface_thickness_mm = o.positive_length("thickness_mm");
-  in.mesh_role = surface ? RecipeInput::MeshRole::kSurface : RecipeInput::MeshRole::kSolid;
-  if (has_file) {
-    in.mesh_file = o.string("file");
-    if (in.mesh_file.empty()) o.fail("file", "expected a file name");
-    return;
-  }
-  TriMesh mesh = inline_mesh(o);
-  for (Vec3d& p : mesh.positions_mm) p = p * in.mesh_scale + in.mesh_translate_mm;
-  if (surface) in.geometry.surfaces.push_back(ThickSurface{std::move(mesh), in.surface_thickness_mm});
-  else in.geometry.solids.push_back(std::move(mesh));
-  in.mesh_role = RecipeInput::MeshRole::kNone;  // nothing left to import
-}
-
-void register_builtin_types() {
-  cifs::register_recipe_inputs();
-  register_infill_inputs();
-  curves::register_recipe_inputs();
-  fill::register_recipe_inputs();
-  voronoi::register_recipe_inputs();
-  bcifs::register_recipe_inputs();
-  register_input_type({"sphere", {"center_mm", "radius_mm"}, [](const JsonObject& o, RecipeInput& in) {
-                         in.geometry.spheres.centers_mm.push_back(o.vec3_or("center_mm", Vec3d{}));
-                         in.geometry.spheres.radii_mm.push_back(o.positive_length("radius_mm"));
-                       }});
-  register_input_type({"spheres", {"centers_mm", "radius_mm", "radii_mm"}, [](const JsonObject& o, RecipeInput& in) {
-                         SphereSet& s = in.geometry.spheres;
-                         s.centers_mm = o.vec3_list("centers_mm");
-                         if (s.centers_mm.empty()) o.fail("centers_mm", "expected at least one centre");
-                         if (o.has("radius_mm") == o.has("radii_mm")) o.fail("", "give either \"radius_mm\" or \"radii_mm\"");
-                         if (o.has("radius_mm")) s.radii_mm = {o.positive_length("radius_mm")};
-                         else s.radii_mm = o.positive_length_list("radii_mm");
-                         if (s.radii_mm.size() != 1 && s.radii_mm.size() != s.centers_mm.size())
-                           o.fail("radii_mm", "expected one radius per centre (" + std::to_string(s.centers_mm.size()) + ")");
-                       }});
-  register_input_type({"capsule", {"a_mm", "b_mm", "radius_mm", "radius_b_mm"}, [](const JsonObject& o, RecipeInput& in) {
-                         double ra = o.positive_length("radius_mm");
-                         double rb = o.positive_length_or("radius_b_mm", ra);
-                         in.geometry.tubes.tubes.push_back(Tube{{o.vec3("a_mm"), o.vec3("b_mm")}, {ra, rb}});
-                       }});
-  register_input_type({"tubes", {"polylines"}, [](const JsonObject& o, RecipeInput& in) {
-                         const nlohmann::json& list = o.required("polylines");
-                         if (!list.is_array() || list.empty()) o.fail("polylines", "expected a non-empty list of polylines");
-                         for (size_t i = 0; i < list.size(); ++i) {
-                           JsonObject p(list[i], o.file(), o.path_of("polylines[" + std::to_string(i) + "]"));
-                           p.allow_only({"points_mm", "radius_mm", "radii_mm"});
-                           Tube tube;
-                           tube.points_mm = p.vec3_list("points_mm");
-                           if (tube.points_mm.empty()) p.fail("points_mm", "expected at least one point");
-                           if (p.has("radius_mm") == p.has("radii_mm")) p.fail("", "give either \"radius_mm\" or \"radii_mm\"");
-                           if (p.has("radius_mm")) tube.radii_mm = {p.positive_length("radius_mm")};
-                           else tube.radii_mm = p.positive_length_list("radii_mm");
-                           if (tube.radii_mm.size() != 1 && tube.radii_mm.size() != tube.points_mm.size())
-                             p.fail("radii_mm", "expected one radius per point (" + std::to_string(tube.points_mm.size()) + ")");
-                           in.geometry.tubes.tubes.push_back(std::move(tube));
-                         }
-                       }});
-  register_input_type({"box", {"center_mm", "size_mm", "min_mm", "max_mm"}, [](const JsonObject& o, RecipeInput& in) {
-                         Shape s;
-                         s.kind = Shape::Kind::kBox;
-                         if (o.has("size_mm")) {
-                           if (o.has("min_mm") || o.has("max_mm")) o.fail("", "give either \"center_mm\" and \"size_mm\" or \"min_mm\" and \"max_mm\"");
-                           Vec3d size = o.vec3("size_mm");
-                           if (!(size.x > 0 && size.y > 0 && size.z > 0)) o.fail("size_mm", "expected three positive lengths in mm");
-                           s.center_mm = o.vec3_or("center_mm", Vec3d{});
-                           s.half_size_mm = size * 0.5;
-                         } else {
-                           if (o.has("center_mm")) o.fail("center_mm", "give \"size_mm\" with \"center_mm\"");
-                           Vec3d lo = o.vec3("min_mm"), hi = o.vec3("max_mm");
-                           if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z)) o.fail("max_mm", "expected max_mm > min_mm on every axis");
-                           s.center_mm = (lo + hi) * 0.5;
-                           s.half_size_mm = (hi - lo) * 0.5;
-                         }
-                         in.geometry.shapes.push_back(s);
-                       }});
-  register_input_type({"cylinder", {"center_mm", "axis", "radius_mm", "height_mm"}, [](const JsonObject& o, RecipeInput& in) {
-                         Shape s;
-                         s.kind = Shape::Kind::kCylinder;
-                         s.center_mm = o.vec3_or("center_mm", Vec3d{});
-                         s.axis = o.direction_or("axis", Vec3d{0, 0, 1});
-                         s.radius_mm = o.positive_length("radius_mm");
-                         s.height_mm = o.positive_length("height_mm");
-                         in.geometry.shapes.push_back(s);
-                       }});
-  register_input_type({"torus", {"center_mm", "axis", "major_radius_mm", "minor_radius_mm"}, [](const JsonObject& o, RecipeInput& in) {
-                         Shape s;
-                         s.kind = Shape::Kind::kTorus;
-                         s.center_mm = o.vec3_or("center_mm", Vec3d{});
-                         s.axis = o.direction_or("axis", Vec3d{0, 0, 1});
-                         s.radius_mm = o.positive_length("major_radius_mm");
-                         s.minor_radius_mm = o.positive_length("minor_radius_mm");
-                         if (s.minor_radius_mm >= s.radius_mm) o.fail("minor_radius_mm", "expected less than major_radius_mm");
-                         in.geometry.shapes.push_back(s);
-                       }});
-  register_input_type({"mesh", {"file", "positions_mm", "triangles", "scale", "translate_mm", "repair"},
-                       [](const JsonObject& o, RecipeInput& in) { parse_mesh_source(o, in, false); }});
-  register_input_type({"surface", {"file", "positions_mm", "triangles", "scale", "translate_mm", "thickness_mm"},
-                       [](const JsonObject& o, RecipeInput& in) { parse_mesh_source(o, in, true); }});
-  register_input_type({"region", {"loops_mm", "height_mm", "origin_mm", "axis_u", "axis_v"}, [](const JsonObject& o, RecipeInput& in) {
-                         Region2 r;
-                         const nlohmann::json& loops = o.required("loops_mm");
-                         if (!loops.is_array() || loops.empty()) o.fail("loops_mm", "expected a list of loops of [x, y] points");
-                         for (size_t i = 0; i < loops.size(); ++i) {
-                           std::string key = "loops_mm[" + std::to_string(i) + "]";
-                           r.loops_mm.push_back(o.vec2_list(loops[i], key));
-                           if (r.loops_mm.back().size() < 3) o.fail(key, "a loop needs at least 3 points");
-                         }
-                         r.height_mm = o.positive_length("height_mm");
-                         r.origin_mm = o.vec3_or("origin_mm", Vec3d{});
-                         r.axis_u = o.direction_or("axis_u", Vec3d{1, 0, 0});
-                         r.axis_v = o.direction_or("axis_v", Vec3d{0, 1, 0});
-                         if (std::fabs(dot(r.axis_u, r.axis_v)) > 1e-9) o.fail("axis_v", "expected a direction orthogonal to axis_u");
-                         in.geometry.regions.push_back(std::move(r));
-                       }});
-}
-
-std::map<std::string, InputType>& types() {
-  static std::once_flag once;
-  std::call_once(once, register_builtin_types);
-  return registry();
+const std::map<std::string, InputType>& types() {
+  static const std::map<std::string, InputType> table = [] {
+    std::map<std::string, InputType> t;
+    for (InputType type : std::vector<InputType>{
+             {"sphere", {"center_mm", "radius_mm"}, parse_as<SphereInput, parse_sphere_input>},
+             {"spheres", {"centers_mm", "radius_mm", "radii_mm"}, parse_as<SpheresInput, parse_spheres_input>},
+             {"capsule", {"a_mm", "b_mm", "radius_mm", "radius_b_mm"}, parse_as<CapsuleInput, parse_capsule_input>},
+             {"tubes", {"polylines"}, parse_as<TubesInput, parse_tubes_input>},
+             {"box", {"center_mm", "size_mm", "min_mm", "max_mm"}, parse_as<BoxInput, parse_box_input>},
+             {"cylinder", {"center_mm", "axis", "radius_mm", "height_mm"}, parse_as<CylinderInput, parse_cylinder_input>},
+             {"torus", {"center_mm", "axis", "major_radius_mm", "minor_radius_mm"}, parse_as<TorusInput, parse_torus_input>},
+             {"mesh", {"file", "positions_mm", "triangles", "scale", "translate_mm", "repair"},
+              parse_as<MeshInput, parse_mesh_input>},
+             {"surface", {"file", "positions_mm", "triangles", "scale", "translate_mm", "thickness_mm"},
+              parse_as<SurfaceInput, parse_surface_input>},
+             {"region", {"loops_mm", "height_mm", "origin_mm", "axis_u", "axis_v"}, parse_as<RegionInput, parse_region_input>},
+             {"lattice",
+              {"cell", "period_mm", "strut_radius_mm", "min_mm", "max_mm", "fit_to", "grade", "layout", "inset_mm"},
+              parse_as<LatticeInput, parse_lattice_input>},
+             {"cifs", {"system", "level", "as", "radius_mm", "thickness_mm", "fit_to"}, parse_as<CifsInput, parse_cifs_input>},
+             {"curve",
+              {"kind", "orders", "radius_mm", "surface", "patch", "mesh", "scale_mm", "center_mm", "offset_mm", "tolerance_mm",
+               "base_mm"},
+              parse_as<CurveInput, parse_curve_input>},
+             {"fill_motifs",
+              {"motif", "region", "wallpaper", "c", "N", "count", "min_area_mm2", "max_trials", "gap_mm", "boundary_gap_mm",
+               "seed", "random_rotation", "height_mm", "base_z_mm", "wrap"},
+              parse_as<FillMotifsInput, parse_fill_motifs_input>},
+             {"fill_spheres",
+              {"fit_to", "box", "sphere", "motif", "random_rotation", "c", "N", "count", "min_radius_mm", "max_trials",
+               "gap_mm", "boundary_gap_mm", "seed"},
+              parse_as<FillSpheresInput, parse_fill_spheres_input>},
+             {"voronoi_spheres", voronoi_keys({"radius_mm", "colours", "tiles"}),
+              parse_as<VoronoiSpheresInput, parse_voronoi_spheres_input>},
+             {"voronoi_tiles", voronoi_keys({"colours", "clearance_mm", "thickness_mm"}),
+              parse_as<VoronoiTilesInput, parse_voronoi_tiles_input>},
+             {"voronoi_foam", voronoi_keys({"wall_mm", "tiles", "cover", "thickness_mm"}),
+              parse_as<VoronoiFoamInput, parse_voronoi_foam_input>},
+             {"bcifs_plate",
+              {"face", "faces", "shared", "level", "thickness_mm", "radius_mm", "gap_fraction", "lacuna_scale", "notch_depth",
+               "origin_mm"},
+              parse_as<BcifsPlateInput, parse_bcifs_plate_input>},
+             {"bcifs_cell",
+              {"cell", "edge_mm", "center_mm", "edge", "params", "algorithm", "level", "thickness_mm", "gap_fraction",
+               "lacuna_scale", "notch_depth"},
+              parse_as<BcifsCellInput, parse_bcifs_cell_input>},
+         })
+      t.emplace(type.type, type);
+    return t;
+  }();
+  return table;
 }
 
 bool valid_name(const std::string& name) {
@@ -198,9 +103,14 @@ std::string lower(std::string s) {
   return s;
 }
 
-}  // namespace
+// A simplification deviation: a finite length of at least 0 mm (0: off).
+double deviation(const JsonObject& o, const char* key) {
+  const double d = o.number(key);
+  if (!(d >= 0) || !std::isfinite(d)) o.fail(key, "expected a deviation of at least 0 mm (0: no simplification)");
+  return d;
+}
 
-void register_input_type(InputType type) { registry()[type.type] = std::move(type); }
+}  // namespace
 
 std::vector<std::string> input_type_names() {
   std::vector<std::string> names;
@@ -224,8 +134,8 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
     throw InvalidInput(path + ": recipe is larger than 256 MB; put large geometry in mesh files");
   nlohmann::json root = parse_json_text(text, path);
   JsonObject top(root, path, "");
-  top.allow_only({"lacuna_recipe", "name", "description", "voxel_size_mm", "band_voxels", "seed", "inputs",
-                  "operations", "outputs", "printability"});
+  top.allow_only({"lacuna_recipe", "name", "description", "voxel_size_mm", "band_voxels", "simplify_mm", "seed",
+                  "inputs", "operations", "outputs", "printability"});
   Recipe recipe;
   recipe.file = path;
   if (top.has("lacuna_recipe") && top.unsigned_integer_or("lacuna_recipe", 1) != 1)
@@ -235,6 +145,7 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
   recipe.voxel_size_mm = top.positive_length_or("voxel_size_mm", 0.1);
   recipe.band_voxels = top.number_or("band_voxels", 3.0);
   if (recipe.band_voxels < 2 || recipe.band_voxels > 16) top.fail("band_voxels", "expected a number from 2 to 16");
+  if (top.has("simplify_mm")) recipe.simplify_mm = deviation(top, "simplify_mm");
   recipe.seed = top.unsigned_integer_or("seed", 0);
 
   std::set<std::string> names;
@@ -248,12 +159,10 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
     RecipeInput input;
     input.name = name;
     input.json_path = o.path();
-    input.type = o.string("type");
-    auto type = types().find(input.type);
+    const std::string type_name = o.string("type");
+    auto type = types().find(type_name);
     if (type == types().end()) {
-      std::string suggestion = closest_match(input.type, input_type_names());
-      std::string message = "unknown input type \"" + input.type + "\"";
-      if (!suggestion.empty()) message += "; did you mean \"" + suggestion + "\"?";
+      std::string message = "unknown input type \"" + type_name + "\"" + did_you_mean(type_name, input_type_names());
       message += " (known types:";
       for (const std::string& t : input_type_names()) message += " " + t;
       o.fail("type", message + ")");
@@ -261,31 +170,30 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
     std::vector<std::string> keys = type->second.keys;
     keys.push_back("type");
     o.allow_only(keys);
-    type->second.parse(o, input);
+    input.spec = type->second.parse(o);
     names.insert(name);
     recipe.inputs.push_back(std::move(input));
   }
 
   for (const RecipeInput& in : recipe.inputs)
-    for (const std::string& dep : in.depends_on) {
+    for (const std::string& dep : dependencies(in.spec)) {
       bool found = false;
       for (const RecipeInput& other : recipe.inputs) found = found || (other.name == dep && &other != &in);
       if (!found) {
         std::vector<std::string> input_names;
         for (const RecipeInput& other : recipe.inputs) input_names.push_back(other.name);
-        std::string suggestion = closest_match(dep, input_names);
         throw InvalidInput(path + ": " + in.json_path + ": \"" + dep + "\" is not another input" +
-                           (suggestion.empty() ? std::string() : "; did you mean \"" + suggestion + "\"?"));
+                           did_you_mean(dep, input_names));
       }
     }
 
   if (top.has("operations")) {
     const nlohmann::json& ops = top.required("operations");
     if (!ops.is_array()) top.fail("operations", "expected a list of operations");
-    const std::map<std::string, RecipeOperation::Kind> kinds = {
-        {"union", RecipeOperation::Kind::kUnion},       {"difference", RecipeOperation::Kind::kDifference},
-        {"intersection", RecipeOperation::Kind::kIntersection}, {"offset", RecipeOperation::Kind::kOffset},
-        {"shell", RecipeOperation::Kind::kShell},       {"infill", RecipeOperation::Kind::kInfill}};
+    enum class Kind { kUnion, kDifference, kIntersection, kOffset, kShell, kInfill };
+    const std::map<std::string, Kind> kinds = {{"union", Kind::kUnion},   {"difference", Kind::kDifference},
+                                               {"intersection", Kind::kIntersection}, {"offset", Kind::kOffset},
+                                               {"shell", Kind::kShell},   {"infill", Kind::kInfill}};
     for (size_t i = 0; i < ops.size(); ++i) {
       JsonObject o(ops[i], path, "operations[" + std::to_string(i) + "]");
       RecipeOperation op;
@@ -294,56 +202,75 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
       if (!valid_name(op.name))
         o.fail("name", "names use letters, digits, '_' and '-', start with a letter or '_', at most 64 characters");
       if (names.count(op.name)) o.fail("name", "\"" + op.name + "\" is already the name of an input or operation");
-      std::string kind = o.string("op");
-      auto k = kinds.find(kind);
+      std::string kind_name = o.string("op");
+      auto k = kinds.find(kind_name);
       if (k == kinds.end()) {
         std::vector<std::string> known;
         for (const auto& e : kinds) known.push_back(e.first);
-        std::string suggestion = closest_match(kind, known);
-        o.fail("op", "unknown operation \"" + kind + "\"" +
-                         (suggestion.empty() ? std::string("; expected union, difference, intersection, offset or shell")
-                                             : "; did you mean \"" + suggestion + "\"?"));
+        const std::string hint = did_you_mean(kind_name, known);
+        o.fail("op", "unknown operation \"" + kind_name + "\"" +
+                         (hint.empty() ? std::string("; expected union, difference, intersection, offset or shell") : hint));
       }
-      op.kind = k->second;
-      bool unary = op.kind == RecipeOperation::Kind::kOffset || op.kind == RecipeOperation::Kind::kShell;
-      if (op.kind == RecipeOperation::Kind::kOffset) o.allow_only({"name", "op", "of", "distance_mm"});
-      else if (op.kind == RecipeOperation::Kind::kShell) o.allow_only({"name", "op", "of", "thickness_mm"});
-      else if (op.kind == RecipeOperation::Kind::kInfill) o.allow_only({"name", "op", "hull", "structure", "skin_mm", "fuse_mm"});
+      const Kind kind = k->second;
+      bool unary = kind == Kind::kOffset || kind == Kind::kShell;
+      if (kind == Kind::kOffset) o.allow_only({"name", "op", "of", "distance_mm"});
+      else if (kind == Kind::kShell) o.allow_only({"name", "op", "of", "thickness_mm"});
+      else if (kind == Kind::kInfill) o.allow_only({"name", "op", "hull", "structure", "skin_mm", "fuse_mm"});
       else o.allow_only({"name", "op", "of"});
-      if (op.kind == RecipeOperation::Kind::kInfill) {
-        op.operands = {o.string("hull"), o.string("structure")};
-        op.thickness_mm = o.positive_length("skin_mm");
-        op.distance_mm = -1;
+      std::vector<std::string> of;
+      InfillOperation infill;
+      if (kind == Kind::kInfill) {
+        infill.hull = o.string("hull");
+        infill.structure = o.string("structure");
+        of = {infill.hull, infill.structure};
+        infill.skin_mm = o.positive_length("skin_mm");
+        infill.fuse_mm = -1;
         if (o.has("fuse_mm")) {
-          op.distance_mm = o.number("fuse_mm");
-          if (op.distance_mm < 0 || op.distance_mm >= op.thickness_mm)
+          infill.fuse_mm = o.number("fuse_mm");
+          if (infill.fuse_mm < 0 || infill.fuse_mm >= infill.skin_mm)
             o.fail("fuse_mm", "expected at least 0 and less than skin_mm");
         }
-      }
-      if (op.kind != RecipeOperation::Kind::kInfill) {
-        const nlohmann::json& of = o.required("of");
+      } else {
+        const nlohmann::json& of_json = o.required("of");
         if (unary) {
-          if (!of.is_string()) o.fail("of", "expected the name of one input or earlier operation");
-          op.operands.push_back(of.get<std::string>());
+          if (!of_json.is_string()) o.fail("of", "expected the name of one input or earlier operation");
+          of.push_back(of_json.get<std::string>());
         } else {
-          if (!of.is_array() || of.size() < 2) o.fail("of", "expected a list of at least two names");
-          for (const auto& n : of) {
+          if (!of_json.is_array() || of_json.size() < 2) o.fail("of", "expected a list of at least two names");
+          for (const auto& n : of_json) {
             if (!n.is_string()) o.fail("of", "expected names (strings)");
-            op.operands.push_back(n.get<std::string>());
+            of.push_back(n.get<std::string>());
           }
         }
       }
-      for (const std::string& ref : op.operands) {
+      for (const std::string& ref : of) {
         if (names.count(ref)) continue;
-        std::string suggestion = closest_match(ref, std::vector<std::string>(names.begin(), names.end()));
-        o.fail(op.kind == RecipeOperation::Kind::kInfill ? "hull" : "of", "\"" + ref + "\" is not an input or an earlier operation" +
-                         (suggestion.empty() ? std::string() : "; did you mean \"" + suggestion + "\"?"));
+        o.fail(kind == Kind::kInfill ? "hull" : "of", "\"" + ref + "\" is not an input or an earlier operation" +
+                         did_you_mean(ref, std::vector<std::string>(names.begin(), names.end())));
       }
-      if (op.kind == RecipeOperation::Kind::kOffset) {
-        op.distance_mm = o.number("distance_mm");
-        if (op.distance_mm == 0) o.fail("distance_mm", "expected a non-zero distance in mm (> 0 grows, < 0 shrinks)");
+      switch (kind) {
+        case Kind::kUnion:
+          op.spec = CsgOperation{CsgOperation::Kind::kUnion, of};
+          break;
+        case Kind::kDifference:
+          op.spec = CsgOperation{CsgOperation::Kind::kDifference, of};
+          break;
+        case Kind::kIntersection:
+          op.spec = CsgOperation{CsgOperation::Kind::kIntersection, of};
+          break;
+        case Kind::kOffset: {
+          OffsetOperation offset{of[0], o.number("distance_mm")};
+          if (offset.distance_mm == 0) o.fail("distance_mm", "expected a non-zero distance in mm (> 0 grows, < 0 shrinks)");
+          op.spec = offset;
+          break;
+        }
+        case Kind::kShell:
+          op.spec = ShellOperation{of[0], o.positive_length("thickness_mm")};
+          break;
+        case Kind::kInfill:
+          op.spec = infill;
+          break;
       }
-      if (op.kind == RecipeOperation::Kind::kShell) op.thickness_mm = o.positive_length("thickness_mm");
       names.insert(op.name);
       recipe.operations.push_back(std::move(op));
     }
@@ -354,14 +281,13 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
   std::set<std::string> files;
   for (size_t i = 0; i < outs.size(); ++i) {
     JsonObject o(outs[i], path, "outputs[" + std::to_string(i) + "]");
-    o.allow_only({"of", "file", "name", "decimate_mm", "fea"});
+    o.allow_only({"of", "file", "name", "simplify_mm", "decimate_mm", "fea"});
     RecipeOutput out;
     out.json_path = o.path();
     auto known = [&](const std::string& name) {
       if (names.count(name)) return;
-      std::string suggestion = closest_match(name, std::vector<std::string>(names.begin(), names.end()));
       o.fail("of", "\"" + name + "\" is not an input or operation" +
-                       (suggestion.empty() ? std::string() : "; did you mean \"" + suggestion + "\"?"));
+                       did_you_mean(name, std::vector<std::string>(names.begin(), names.end())));
     };
     if (o.required("of").is_array()) {
       // Several objects in one 3MF package.
@@ -396,7 +322,10 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
     if (!out.group.empty() && o.has("name")) o.fail("name", "the objects of a list are named after their inputs");
     if (lower(out.file) == "report.json" || !files.insert(lower(out.file)).second)
       o.fail("file", "\"" + out.file + "\" is written twice or clashes with report.json");
-    out.decimate_mm = o.positive_length_or("decimate_mm", 0.0);
+    if (o.has("simplify_mm") && o.has("decimate_mm"))
+      o.fail("decimate_mm", "give \"simplify_mm\" only (\"decimate_mm\" is its older name)");
+    if (o.has("simplify_mm")) out.simplify_mm = deviation(o, "simplify_mm");
+    if (o.has("decimate_mm")) out.simplify_mm = deviation(o, "decimate_mm");
     const bool tetrahedral = out.format != "stl" && out.format != "3mf";
     if (o.has("fea")) {
       if (!tetrahedral) o.fail("fea", "tetrahedral settings need a .msh, .inp, .vtu or .mesh file");
@@ -452,6 +381,39 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
     p.drain_down = drain == "down";
   }
   return recipe;
+}
+
+std::vector<std::string> dependencies(const InputSpec& spec) {
+  if (const auto* lattice = std::get_if<LatticeInput>(&spec))
+    return lattice->fit_to ? std::vector<std::string>{*lattice->fit_to} : std::vector<std::string>{};
+  if (const auto* cifs = std::get_if<CifsInput>(&spec))
+    return cifs->fit_to ? std::vector<std::string>{*cifs->fit_to} : std::vector<std::string>{};
+  if (const auto* fill = std::get_if<FillSpheresInput>(&spec))
+    return fill->region == FillSpheresInput::Region::kFitTo ? std::vector<std::string>{fill->fit_to}
+                                                            : std::vector<std::string>{};
+  if (const auto* foam = std::get_if<VoronoiFoamInput>(&spec))
+    return foam->cover ? std::vector<std::string>{*foam->cover} : std::vector<std::string>{};
+  return {};
+}
+
+bool built_after_others(const InputSpec& spec) {
+  if (const auto* curve = std::get_if<CurveInput>(&spec))
+    if (curve->surface == CurveInput::Surface::kMesh) return true;
+  return !dependencies(spec).empty();
+}
+
+std::vector<std::string> operands(const OperationSpec& op) {
+  if (const auto* csg = std::get_if<CsgOperation>(&op)) return csg->of;
+  if (const auto* offset = std::get_if<OffsetOperation>(&op)) return {offset->of};
+  if (const auto* shell = std::get_if<ShellOperation>(&op)) return {shell->of};
+  const auto& infill = std::get<InfillOperation>(op);
+  return {infill.hull, infill.structure};
+}
+
+double simplify_deviation_mm(const Recipe& recipe, const RecipeOutput& output) {
+  if (output.simplify_mm) return *output.simplify_mm;
+  if (recipe.simplify_mm) return *recipe.simplify_mm;
+  return kDefaultSimplifyVoxels * recipe.voxel_size_mm;
 }
 
 }  // namespace lacuna

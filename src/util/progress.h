@@ -1,21 +1,50 @@
-// A progress bar for long stages, drawn on stderr only when it is a terminal and not silenced.
+// Progress and cancellation of long stages. The library only reports: a front end passes a
+// ProgressSink (the command line's draws bars on a terminal), and stages report to the sink that
+// is current on the thread that started them. Nothing here draws.
 #pragma once
 
-#include <atomic>
-#include <chrono>
 #include <cstdint>
-#include <mutex>
 #include <string>
 
 namespace lacuna {
 
-// Turns progress output on or off for the whole program (off by default; the command line turns
-// it on when stderr is a terminal and --quiet is not given).
-void set_progress_enabled(bool enabled);
-bool progress_enabled();
+// What a front end implements to follow the stages of a call and to stop it. begin() and end()
+// come from the thread that runs the call, in nested pairs; advance() from any thread.
+class ProgressSink {
+ public:
+  virtual ~ProgressSink() = default;
+  // A stage of `total` steps starts (a stage inside another ends before it).
+  virtual void begin(const std::string& stage, uint64_t total) = 0;
+  // `n` more steps of the innermost stage are done.
+  virtual void advance(uint64_t n) = 0;
+  // The innermost stage ends.
+  virtual void end() = 0;
+  // Whether the caller wants the work stopped; stages then throw Cancelled at their next start.
+  virtual bool cancelled() const { return false; }
+};
 
-// One stage's bar. advance() may be called from any thread; the bar is redrawn at most ten times
-// a second and erased when the stage ends.
+// Makes `sink` (may be null: no reports) the one stages started on this thread report to, until
+// the scope ends; the previous one is current again afterwards.
+class ProgressSinkScope {
+ public:
+  explicit ProgressSinkScope(ProgressSink* sink);
+  ~ProgressSinkScope();
+  ProgressSinkScope(const ProgressSinkScope&) = delete;
+  ProgressSinkScope& operator=(const ProgressSinkScope&) = delete;
+
+ private:
+  ProgressSink* previous_;
+};
+
+// The sink current on this thread, or null.
+ProgressSink* current_progress_sink();
+
+// Throws Cancelled when `sink` is set and asks to stop.
+void throw_if_cancelled(const ProgressSink* sink);
+
+// One stage's progress, reported to the sink current on the thread that creates it: begin on
+// construction (throwing Cancelled first when the sink asks to stop), end on destruction.
+// advance() may be called from any thread.
 class Progress {
  public:
   Progress(std::string stage, uint64_t total);
@@ -26,15 +55,7 @@ class Progress {
   void advance(uint64_t n = 1);
 
  private:
-  void draw(uint64_t done);
-
-  std::string stage_;
-  uint64_t total_;
-  std::atomic<uint64_t> done_{0};
-  std::atomic<int64_t> next_draw_ns_{0};
-  std::chrono::steady_clock::time_point start_;
-  std::mutex draw_mutex_;
-  bool enabled_;
+  ProgressSink* sink_;
 };
 
 }  // namespace lacuna

@@ -1,5 +1,5 @@
-// The `fill_motifs` and `fill_spheres` recipe inputs: random fractal fillings turned into solids
-// (motif prisms for lacunar panels, spheres for porous parts).
+// Placed motifs of a random fractal filling turned into solids: prisms for lacunar panels, flat or
+// wrapped around a cylinder.
 #pragma once
 
 #include <vector>
@@ -9,8 +9,6 @@
 
 namespace lacuna {
 namespace fill {
-
-void register_recipe_inputs();
 
 // Where placed motifs become solids: prisms of `height_mm` standing on z = base_z_mm, or, when
 // wrap_radius_mm > 0, radial prisms of that depth centred on the cylinder of that radius about the z

@@ -2,7 +2,7 @@
 // `lacuna fea`.
 #pragma once
 
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
 
@@ -13,12 +13,17 @@
 
 namespace lacuna {
 
-struct FeaResult {
-  MeshCheckReport surface;       // the surface handed to TetGen
-  TetMesh mesh;
-  TetReport report;
+// What verifying a tetrahedral mesh and its surface found.
+struct TetCheck {
+  MeshCheckReport surface;            // the surface handed to TetGen
+  TetReport report;                   // the tetrahedra
   std::vector<std::string> problems;  // empty when the surface and the tetrahedra passed
   bool valid() const { return problems.empty(); }
+};
+
+struct FeaResult {
+  TetMesh mesh;
+  TetCheck check;
 };
 
 // Checks the surface (it must be a valid solid), tetrahedralizes it with the settings, and
@@ -27,7 +32,13 @@ struct FeaResult {
 FeaResult make_fea_mesh(const TriMesh& surface, const FeaSettings& settings,
                         const std::vector<Vec3d>& region_seeds = {});
 
+// Tetrahedralizes the closed mesh in the file `mesh_path` (simplified with guards to `simplify_mm`
+// first when it is > 0) and, when the surface and the tetrahedra pass their checks, writes them to
+// `output_path` (the format from its extension) through a temporary file; nothing is written otherwise.
+TetCheck write_tetrahedra(const std::string& mesh_path, const std::string& output_path, const FeaSettings& settings,
+                          double simplify_mm = 0);
+
 // The report entry of a tetrahedral output.
-nlohmann::json fea_report_json(const FeaResult& result);
+nlohmann::json fea_report_json(const TetCheck& check);
 
 }  // namespace lacuna

@@ -1,17 +1,23 @@
-#include "cli/fea_output.h"
+#include "pipeline/fea_output.h"
 
 #include <cmath>
+#include <nlohmann/json.hpp>
 
+#include "export/fea.h"
+#include "export/mesh_io.h"
+#include "export/output_files.h"
 #include "export/report.h"
+#include "solids/simplify.h"
 
 namespace lacuna {
 
 FeaResult make_fea_mesh(const TriMesh& surface, const FeaSettings& settings, const std::vector<Vec3d>& region_seeds) {
-  FeaResult r;
+  FeaResult result;
+  TetCheck& r = result.check;
   r.surface = check_mesh(surface);
   if (!r.surface.valid()) {
     for (const std::string& p : r.surface.problems()) r.problems.push_back("surface: " + p);
-    return r;
+    return result;
   }
   TetOptions options;
   options.max_radius_edge_ratio = settings.quality;
@@ -19,8 +25,8 @@ FeaResult make_fea_mesh(const TriMesh& surface, const FeaSettings& settings, con
   options.max_tet_volume_mm3 = settings.max_tet_volume_mm3;
   options.preserve_surface = settings.preserve_surface;
   options.time_limit_s = settings.time_limit_s;
-  r.mesh = tetrahedralize(surface, options, region_seeds);
-  r.report = tet_report(r.mesh);
+  result.mesh = tetrahedralize(surface, options, region_seeds);
+  r.report = tet_report(result.mesh);
   if (r.report.tets == 0) r.problems.push_back("TetGen produced no tetrahedra");
   if (r.report.inverted_tets) r.problems.push_back(std::to_string(r.report.inverted_tets) + " tetrahedra have no positive volume");
   // A preserved surface bounds exactly the same volume; when TetGen may refine, it can also
@@ -34,10 +40,29 @@ FeaResult make_fea_mesh(const TriMesh& surface, const FeaSettings& settings, con
                          " mm3 differs from the surface's " + std::to_string(expected) + " mm3");
   if (settings.max_tet_volume_mm3 > 0 && r.report.max_tet_volume_mm3 > settings.max_tet_volume_mm3 * (1 + 1e-9))
     r.problems.push_back("a tetrahedron exceeds the volume bound");
-  return r;
+  return result;
 }
 
-nlohmann::json fea_report_json(const FeaResult& r) {
+TetCheck write_tetrahedra(const std::string& mesh_path, const std::string& output_path, const FeaSettings& settings,
+                          double simplify_mm) {
+  TriMesh surface = read_mesh(mesh_path);
+  if (simplify_mm > 0) {
+    SimplifyOptions simplify;
+    simplify.max_deviation_mm = simplify_mm;
+    surface = simplify_mesh(surface, simplify);
+  }
+  FeaResult fea = make_fea_mesh(surface, settings);
+  if (!fea.check.valid()) return fea.check;
+  OutputTransaction transaction;
+  FeaWriteOptions w;
+  w.msh_version_2 = settings.msh_version_2;
+  w.quadratic = settings.quadratic;
+  write_fea(transaction.stage(output_path), fea_format_from_path(output_path), fea.mesh, w);
+  transaction.commit();
+  return fea.check;
+}
+
+nlohmann::json fea_report_json(const TetCheck& r) {
   nlohmann::json histogram = nlohmann::json::array();
   for (size_t i = 0; i < r.report.ratio_counts.size(); ++i)
     histogram.push_back({{"below", i < r.report.ratio_bins.size() ? nlohmann::json(r.report.ratio_bins[i]) : nlohmann::json(nullptr)},

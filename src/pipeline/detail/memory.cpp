@@ -1,0 +1,32 @@
+#include "pipeline/detail/memory.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include "errors.h"
+#include "solids/budget.h"
+#include "util/system.h"
+
+namespace lacuna {
+namespace detail {
+
+std::string fixed(double v, int digits) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.*g", digits, v);
+  return text;
+}
+
+std::string refusal(const std::string& what, uint64_t need, uint64_t budget, const VolumeOptions& vopt) {
+  double scale = std::sqrt(double(need) / double(budget)) * 1.05;
+  return what + " needs about " + format_bytes(need) + ", more than the budget of " + format_bytes(budget) +
+         " (--max-memory); a voxel size of " + fixed(vopt.voxel_size_mm * scale, 3) + " mm or larger would fit" +
+         " (now " + fixed(vopt.voxel_size_mm, 4) + " mm)";
+}
+
+void require_mesh_memory(const Volume& v, uint64_t budget, const std::string& what, const VolumeOptions& vopt) {
+  uint64_t need = estimate_from_voxels(v.active_voxel_count(), vopt).mesh_bytes + current_memory_bytes();
+  if (need > budget) throw ResourceLimit(refusal(what, need, budget, vopt));
+}
+
+}  // namespace detail
+}  // namespace lacuna

@@ -1,0 +1,197 @@
+#include "pipeline/evaluate.h"
+
+#include <algorithm>
+#include <cmath>
+#include <variant>
+
+#include "errors.h"
+#include "pipeline/detail/memory.h"
+#include "solids/budget.h"
+#include "solids/infill.h"
+#include "solids/voxelize.h"
+#include "util/system.h"
+
+namespace lacuna {
+namespace {
+
+using detail::fixed;
+
+// float32 output keeps crossing points apart only while |coordinate| / voxel stays below this
+// (see extract.h: crossings sit at least 1% of a voxel from grid points).
+constexpr double kMaxCoordinateInVoxels = 131072.0;
+
+// Runs `step`, prefixing any InvalidInput it throws with `where` (file and JSON path).
+template <typename Step>
+auto in_context(const std::string& where, Step&& step) {
+  try {
+    return step();
+  } catch (const InvalidInput& e) {
+    throw InvalidInput(where + ": " + e.what());
+  }
+}
+
+const RecipeInput& input_named(const Recipe& recipe, const std::string& name) {
+  for (const RecipeInput& in : recipe.inputs)
+    if (in.name == name) return in;
+  throw InternalError("no input is named \"" + name + "\"");
+}
+
+const RecipeOperation& operation_named(const Recipe& recipe, const std::string& name) {
+  for (const RecipeOperation& op : recipe.operations)
+    if (op.name == name) return op;
+  throw InternalError("no operation is named \"" + name + "\"");
+}
+
+// Memory for everything the plan builds, refused before any large allocation: every level set
+// it keeps (conservatively, all of them at once) plus the largest surface it meshes and checks.
+struct Estimate {
+  uint64_t grid_bytes = 0;
+  uint64_t mesh_bytes = 0;
+  uint64_t voxels = 0;
+  uint64_t triangles = 0;
+  uint64_t bytes() const { return grid_bytes + mesh_bytes; }
+};
+
+Estimate estimate(const Recipe& recipe, const Plan& plan, const BuiltInputs& inputs, const VolumeOptions& vopt) {
+  struct Object {
+    double area = 0;
+    Box3 box;
+    uint64_t voxels = 0;
+  };
+  std::map<std::string, Object> objects;
+  Estimate total;
+  auto mesh_of = [&](uint64_t voxels) {
+    MemoryEstimate m = estimate_from_voxels(voxels, vopt);
+    if (m.mesh_bytes > total.mesh_bytes) {
+      total.mesh_bytes = m.mesh_bytes;
+      total.triangles = m.triangles;
+    }
+  };
+  for (const std::string& name : plan.inputs) {
+    const GeometrySet& geometry = inputs.at(name).geometry;
+    MemoryEstimate e = in_context(recipe.file + ": " + input_named(recipe, name).json_path,
+                                  [&] { return estimate_voxelize(geometry, vopt); });
+    objects[name] = {e.surface_area_mm2, bounding_box(geometry), e.active_voxels};
+    total.grid_bytes += e.grid_bytes;
+    total.voxels += e.active_voxels;
+  }
+  for (const std::string& name : plan.operations) {
+    const OperationSpec& op = operation_named(recipe, name).spec;
+    const std::vector<std::string> of = operands(op);
+    Object o;
+    const Object& first = objects[of[0]];
+    o.box = first.box;
+    const auto* csg = std::get_if<CsgOperation>(&op);
+    for (const std::string& operand : of) {
+      o.area += objects[operand].area;
+      if (csg && csg->kind == CsgOperation::Kind::kUnion) o.box.expand(objects[operand].box);
+    }
+    VolumeOptions work = vopt;
+    if (!csg) {
+      // Goes through the operand's surface mesh and a band as wide as the distance.
+      const auto* offset = std::get_if<OffsetOperation>(&op);
+      const auto* shell = std::get_if<ShellOperation>(&op);
+      double d = offset ? std::fabs(offset->distance_mm) : shell ? shell->thickness_mm : std::get<InfillOperation>(op).skin_mm;
+      mesh_of(first.voxels);
+      work.half_band_voxels += d / vopt.voxel_size_mm;
+      if (offset && offset->distance_mm > 0) {
+        o.box.min -= Vec3d{d, d, d};
+        o.box.max += Vec3d{d, d, d};
+      }
+      MemoryEstimate wide = estimate_from_voxels(band_voxels(o.area, o.box, work), work);
+      total.grid_bytes += wide.grid_bytes;
+    }
+    o.voxels = band_voxels(o.area, o.box, vopt);
+    MemoryEstimate e = estimate_from_voxels(o.voxels, vopt);
+    total.grid_bytes += e.grid_bytes;
+    total.voxels += e.active_voxels;
+    objects[name] = o;
+  }
+  for (const RecipeOutput& out : recipe.outputs)
+    for (const std::string& name : members(out)) mesh_of(objects[name].voxels);
+  return total;
+}
+
+}  // namespace
+
+Volume Evaluation::take(const std::string& name) {
+  Volume v = volumes.at(name);
+  if (--uses[name] == 0) volumes.erase(name);
+  return v;
+}
+
+Evaluation evaluate(const Recipe& recipe, const Plan& plan, const BuiltInputs& inputs, const EvaluateOptions& options) {
+  ProgressSinkScope progress(options.progress ? options.progress : current_progress_sink());
+  ProgressSink* sink = current_progress_sink();
+  const VolumeOptions vopt{recipe.voxel_size_mm, recipe.band_voxels};
+  Evaluation result;
+  result.memory_budget_bytes = options.max_memory_bytes ? options.max_memory_bytes : available_memory_bytes() / 2;
+  const uint64_t budget = result.memory_budget_bytes;
+
+  // Refuse what cannot fit before building anything large.
+  Box3 extent;
+  for (const std::string& name : plan.inputs) extent.expand(bounding_box(inputs.at(name).geometry));
+  double reach = 0;
+  for (int k = 0; k < 3; ++k) reach = std::max({reach, std::fabs(extent.min[k]), std::fabs(extent.max[k])});
+  if (reach / vopt.voxel_size_mm > kMaxCoordinateInVoxels)
+    throw ResourceLimit(recipe.file + ": the part reaches " + fixed(reach, 6) + " mm from the origin, more than " +
+                        fixed(kMaxCoordinateInVoxels, 6) + " voxels of " + fixed(vopt.voxel_size_mm, 6) +
+                        " mm; float32 output cannot keep such a fine surface exact. Move the part nearer the origin "
+                        "or use a voxel size of at least " + fixed(reach / kMaxCoordinateInVoxels, 3) + " mm");
+  Estimate need = estimate(recipe, plan, inputs, vopt);
+  result.memory_estimate_bytes = need.bytes();
+  if (need.bytes() > budget)
+    throw ResourceLimit(detail::refusal(recipe.file + ": this recipe (about " + fixed(double(need.voxels), 3) +
+                                            " voxels and " + fixed(double(need.triangles), 3) + " triangles)",
+                                        need.bytes(), budget, vopt));
+
+  // Volumes, built in recipe order and released after their last use.
+  result.uses = plan.uses;
+  StageTimer timer;
+  timer.start("voxelize");
+  for (const std::string& name : plan.inputs) {
+    throw_if_cancelled(sink);
+    result.volumes[name] = in_context(recipe.file + ": " + input_named(recipe, name).json_path,
+                                      [&] { return voxelize(inputs.at(name).geometry, vopt); });
+  }
+  timer.start("combine");
+  for (const std::string& name : plan.operations) {
+    throw_if_cancelled(sink);
+    const RecipeOperation& op = operation_named(recipe, name);
+    const std::string where = recipe.file + ": " + op.json_path;
+    Volume v;
+    if (const auto* csg = std::get_if<CsgOperation>(&op.spec)) {
+      v = result.take(csg->of[0]);
+      for (size_t i = 1; i < csg->of.size(); ++i) {
+        const Volume next = result.take(csg->of[i]);
+        switch (csg->kind) {
+          case CsgOperation::Kind::kUnion: v = unite(v, next); break;
+          case CsgOperation::Kind::kDifference: v = subtract(v, next); break;
+          case CsgOperation::Kind::kIntersection: v = intersect(v, next); break;
+        }
+      }
+    } else if (const auto* offset = std::get_if<OffsetOperation>(&op.spec)) {
+      v = result.take(offset->of);
+      detail::require_mesh_memory(v, budget, where, vopt);
+      v = lacuna::offset(v, offset->distance_mm);
+    } else if (const auto* shell = std::get_if<ShellOperation>(&op.spec)) {
+      v = result.take(shell->of);
+      detail::require_mesh_memory(v, budget, where, vopt);
+      v = lacuna::shell(v, shell->thickness_mm);
+    } else {
+      const auto& fill = std::get<InfillOperation>(op.spec);
+      Volume hull = result.take(fill.hull), structure = result.take(fill.structure);
+      detail::require_mesh_memory(hull, budget, where, vopt);
+      // Fused by a voxel unless told otherwise (and never through the whole skin).
+      double fuse = fill.fuse_mm >= 0 ? fill.fuse_mm : std::min(vopt.voxel_size_mm, 0.5 * fill.skin_mm);
+      v = in_context(where, [&] { return infill(hull, structure, fill.skin_mm, fuse); });
+      result.hull_volume_mm3[op.name] = hull.voxel_volume_mm3();
+    }
+    result.volumes[op.name] = v;
+  }
+  timer.stop();
+  result.stage_seconds = timer.seconds();
+  return result;
+}
+
+}  // namespace lacuna

@@ -1,0 +1,314 @@
+#include "pipeline/write_outputs.h"
+
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
+
+#include "errors.h"
+#include "export/fea.h"
+#include "export/mesh_io.h"
+#include "export/output_files.h"
+#include "pipeline/detail/memory.h"
+#include "pipeline/fea_output.h"
+#include "solids/check.h"
+#include "solids/components.h"
+#include "solids/extract.h"
+#include "solids/simplify.h"
+#include "solids/printability.h"
+#include "util/system.h"
+
+namespace lacuna {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Material region of every tetrahedron: the first region solid its centroid lies in, else the
+// nearest one (tetrahedra straddling an interface go to the side holding their centroid).
+void assign_regions(TetMesh& mesh, const std::vector<Volume>& regions) {
+  mesh.regions.assign(mesh.tets.size(), 0);
+  tbb::parallel_for(size_t(0), mesh.tets.size(), [&](size_t t) {
+    const auto& tet = mesh.tets[t];
+    Vec3d c = (mesh.nodes_mm[tet[0]] + mesh.nodes_mm[tet[1]] + mesh.nodes_mm[tet[2]] + mesh.nodes_mm[tet[3]]) * 0.25;
+    double best = HUGE_VAL;
+    for (size_t r = 0; r < regions.size(); ++r) {
+      double d = regions[r].distance_at(c);
+      if (d < 0) {
+        mesh.regions[t] = int(r);
+        return;
+      }
+      if (d < best) {
+        best = d;
+        mesh.regions[t] = int(r);
+      }
+    }
+  });
+}
+
+// Printability of an object before it is meshed; with "fix", thin walls are thickened and drain
+// holes drilled from its trapped voids (the object changes), and it is analysed again.
+PrintabilityFindings check_printability(Volume& volume, const PrintabilitySettings& settings) {
+  PrintabilityOptions options;
+  options.min_wall_mm = settings.min_wall_mm;
+  options.min_hole_mm = settings.min_hole_mm;
+  options.build_direction = settings.build_direction;
+  options.critical_angle_deg = settings.critical_angle_deg;
+  PrintabilityReport report = analyze_printability(volume, options);
+  size_t drilled = 0, thickened = 0;
+  if (settings.on_failure == PrintabilitySettings::OnFailure::kFix && !report.ok()) {
+    // Thin walls first (growing them can seal nothing new), then drain holes.
+    if (!report.thin_walls.empty()) {
+      thickened = report.thin_walls.size();
+      volume = thicken_thin_walls(volume, report, settings.min_wall_mm);
+      report = analyze_printability(volume, options);
+    }
+    if (!report.trapped_voids.empty()) {
+      drilled = report.trapped_voids.size();
+      volume = drill_drain_holes(volume, report.trapped_voids, settings.drain_hole_mm, options, settings.drain_down);
+      report = analyze_printability(volume, options);
+    }
+  }
+  PrintabilityFindings f;
+  f.trapped_voids = report.trapped_voids;
+  f.thin_walls = report.thin_walls;
+  f.small_holes = report.small_holes;
+  f.overhang_area_mm2 = report.overhang_area_mm2;
+  f.down_facing_area_mm2 = report.down_facing_area_mm2;
+  f.drain_holes = drilled;
+  f.thickened_walls = thickened;
+  if (settings.on_failure != PrintabilitySettings::OnFailure::kReport) {
+    if (!report.trapped_voids.empty())
+      f.problems.push_back(std::to_string(report.trapped_voids.size()) + " trapped voids (powder or resin cannot drain)");
+    if (!report.thin_walls.empty())
+      f.problems.push_back(std::to_string(report.thin_walls.size()) + " walls thinner than " +
+                           detail::fixed(settings.min_wall_mm, 4) + " mm");
+    if (!report.small_holes.empty())
+      f.problems.push_back(std::to_string(report.small_holes.size()) + " holes narrower than " +
+                           detail::fixed(settings.min_hole_mm, 4) + " mm");
+  }
+  return f;
+}
+
+ThreeMfInfo package_info(const Recipe& recipe) {
+  ThreeMfInfo info;
+  info.metadata = {{"Application", "Lacuna " LACUNA_VERSION}, {"Title", recipe.name}};
+  if (!recipe.description.empty()) info.metadata.push_back({"Description", recipe.description});
+  return info;
+}
+
+}  // namespace
+
+std::string output_folder(const Recipe& recipe, const WriteOptions& options) {
+  return options.output_dir.empty() ? recipe.name + "-out" : options.output_dir;
+}
+
+void check_output_folder(const Recipe& recipe, const WriteOptions& options) {
+  const fs::path out_dir = output_folder(recipe, options);
+  std::error_code ec;
+  if (fs::exists(out_dir, ec) && !fs::is_directory(out_dir, ec))
+    throw IoError(out_dir.string() + ": exists and is not a folder");
+}
+
+RunReport write_outputs(const Recipe& recipe, const Plan& plan, Evaluation&& evaluation, const BuiltInputs& inputs,
+                        const WriteOptions& options) {
+  ProgressSinkScope progress(options.progress ? options.progress : current_progress_sink());
+  ProgressSink* sink = current_progress_sink();
+  const VolumeOptions vopt{recipe.voxel_size_mm, recipe.band_voxels};
+  const uint64_t budget = evaluation.memory_budget_bytes;
+  const fs::path out_dir = output_folder(recipe, options);
+  std::error_code ec;
+  bool created_dir = !fs::exists(out_dir, ec);
+  if (!created_dir && !fs::is_directory(out_dir, ec)) throw IoError(out_dir.string() + ": exists and is not a folder");
+  fs::create_directories(out_dir, ec);
+  if (ec) throw IoError(out_dir.string() + ": cannot create the output folder: " + ec.message());
+
+  OutputTransaction transaction;
+  RunReport report;
+  StageTimer timer;
+  try {
+    // Each exported object is meshed once and written in every format asked for; then every
+    // written file is read back and checked as the file it is.
+    // The meshes of a group wait here until its last object is meshed.
+    std::map<const RecipeOutput*, std::map<std::string, TriMesh>> pending;
+    for (const std::string& object : plan.exported) {
+      throw_if_cancelled(sink);
+      timer.start("mesh");
+      Volume volume = evaluation.take(object);
+      detail::require_mesh_memory(volume, budget, recipe.file + ": meshing \"" + object + "\"", vopt);
+      std::optional<PrintabilityFindings> printability;
+      if (recipe.printability.enabled) {
+        timer.start("printability");
+        printability = check_printability(volume, recipe.printability);
+        timer.start("mesh");
+      }
+      const uint64_t voxels = volume.active_voxel_count();
+      // One surface per deviation the object's outputs ask for (usually one): the compact mesh is
+      // extracted and simplified block by block, so the full marching-tetrahedra mesh never exists.
+      struct Surface {
+        TriMesh mesh;
+        uint64_t extracted_triangles = 0;
+        size_t filled = 0, specks = 0;
+      };
+      std::map<double, Surface> surfaces;
+      for (const RecipeOutput& out : recipe.outputs) {
+        const bool exports = out.object == object ||
+                             std::find(out.group.begin(), out.group.end(), object) != out.group.end();
+        const double deviation = simplify_deviation_mm(recipe, out);
+        if (!exports || surfaces.count(deviation)) continue;
+        Surface& surface = surfaces[deviation];
+        if (deviation > 0) {
+          SimplifyOptions simplify;
+          simplify.max_deviation_mm = deviation;
+          SimplifyStats stats;
+          surface.mesh = extract_simplified_surface(volume, simplify, &stats);
+          surface.extracted_triangles = stats.input_triangles;
+        } else {
+          surface.mesh = extract_surface(volume);
+          surface.extracted_triangles = surface.mesh.triangles.size();
+        }
+        const double h = volume.voxel_size_mm();
+        surface.filled = fill_small_cavities(surface.mesh, h * h * h);
+        surface.specks = remove_small_specks(surface.mesh, h * h * h);
+        if (surface.mesh.triangles.empty())
+          throw InvalidInput(recipe.file + ": \"" + object + "\" is empty: nothing is left to export");
+      }
+      volume = Volume();
+      auto surface_for = [&](const RecipeOutput& out) -> const Surface& {
+        return surfaces.at(simplify_deviation_mm(recipe, out));
+      };
+      // What every entry of this object's outputs shares: the mesh's figures, its printability, and
+      // the hull volume of the output's object.
+      auto entry_for = [&](const RecipeOutput& out, const std::string& final_path) {
+        const Surface& surface = surface_for(out);
+        OutputReport entry;
+        entry.file = final_path;
+        entry.format = out.format;
+        entry.object = out.object;
+        entry.voxels = voxels;
+        entry.subvoxel_cavities_filled = surface.filled;
+        entry.subvoxel_specks_removed = surface.specks;
+        entry.simplify_mm = simplify_deviation_mm(recipe, out);
+        entry.extracted_triangles = surface.extracted_triangles;
+        entry.printability = printability;
+        auto hull = evaluation.hull_volume_mm3.find(out.object);
+        if (hull != evaluation.hull_volume_mm3.end()) entry.hull_volume_mm3 = hull->second;
+        return entry;
+      };
+      struct Written {
+        const RecipeOutput* out;
+        std::string temp;
+        std::string final_path;
+      };
+      std::vector<Written> written;
+      for (const RecipeOutput& out : recipe.outputs) {
+        if (!out.group.empty()) {
+          if (std::find(out.group.begin(), out.group.end(), object) == out.group.end()) continue;
+          std::map<std::string, TriMesh>& parts = pending[&out];
+          parts[object] = surface_for(out).mesh;
+          if (parts.size() < out.group.size()) continue;
+          timer.start("write");
+          const std::string final_path = (out_dir / out.file).string();
+          std::string temp = transaction.stage(final_path);
+          std::vector<ThreeMfObject> objects3mf;
+          for (const std::string& name : out.group) objects3mf.push_back({&parts[name], name});
+          write_3mf(temp, objects3mf, package_info(recipe));
+          pending.erase(&out);
+          written.push_back({&out, temp, final_path});
+          continue;
+        }
+        if (out.object != object) continue;
+        std::string final_path = (out_dir / out.file).string();
+        const TriMesh& surface = surface_for(out).mesh;
+        if (out.format == "stl" || out.format == "3mf") {
+          timer.start("write");
+          std::string temp = transaction.stage(final_path);
+          if (out.format == "stl") {
+            write_stl(temp, surface, "Lacuna " LACUNA_VERSION " " + recipe.name + " " + out.part_name);
+          } else {
+            ThreeMfInfo info = package_info(recipe);
+            info.object_name = out.part_name;
+            write_3mf(temp, surface, info);
+          }
+          written.push_back({&out, temp, final_path});
+          continue;
+        }
+        timer.start("tetrahedralize");
+        FeaResult fea = make_fea_mesh(surface, out.fea);
+        if (fea.check.valid() && !out.fea.regions.empty()) {
+          std::vector<Volume> regions;
+          for (const std::string& name : out.fea.regions) regions.push_back(evaluation.volumes.at(name));
+          assign_regions(fea.mesh, regions);
+        }
+        if (fea.check.valid()) {
+          timer.start("write");
+          FeaWriteOptions w;
+          w.msh_version_2 = out.fea.msh_version_2;
+          w.quadratic = out.fea.quadratic;
+          write_fea(transaction.stage(final_path), fea_format_from_path(final_path), fea.mesh, w);
+        }
+        OutputReport entry = entry_for(out, final_path);
+        entry.tetrahedra = std::move(fea.check);
+        report.outputs.push_back(std::move(entry));
+      }
+      for (auto& entry : surfaces) entry.second.mesh = TriMesh();  // the figures stay for the entries
+      timer.start("check");
+      for (const Written& w : written) {
+        ReadOptions read;
+        read.max_memory_bytes = budget;
+        std::vector<std::string> names;
+        if (!w.out->group.empty()) read.object_names = &names;
+        TriMesh back = read_mesh(w.temp, mesh_format_from_path(w.final_path), read);
+        OutputReport entry = entry_for(*w.out, w.final_path);
+        entry.check = check_mesh(back);
+        entry.group = w.out->group;
+        entry.objects = names;
+        entry.part_name = w.out->part_name;
+        report.outputs.push_back(std::move(entry));
+      }
+      for (const RecipeOutput& out : recipe.outputs)
+        if (out.object == object)
+          for (const std::string& name : out.fea.regions)
+            if (--evaluation.uses[name] == 0) evaluation.volumes.erase(name);
+    }
+    timer.stop();
+
+    report.lacuna_version = LACUNA_VERSION;
+    report.recipe = recipe.file;
+    report.name = recipe.name;
+    report.voxel_size_mm = vopt.voxel_size_mm;
+    report.band_voxels = vopt.half_band_voxels;
+    report.seed = recipe.seed;
+    report.valid = std::all_of(report.outputs.begin(), report.outputs.end(), [](const OutputReport& o) { return o.valid(); });
+    report.stage_seconds = evaluation.stage_seconds;
+    for (const auto& s : timer.seconds()) report.stage_seconds.push_back(s);
+    report.peak_memory_bytes = peak_memory_bytes();
+    report.peak_memory_children_bytes = peak_child_memory_bytes();
+    report.memory_estimate_bytes = evaluation.memory_estimate_bytes;
+    report.memory_budget_bytes = budget;
+    report.threads = tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
+    for (size_t i = 0; i < inputs.names.size(); ++i) report.inputs.emplace_back(inputs.names[i], inputs.inputs[i].report);
+    if (!report.valid) {
+      transaction.rollback();
+      if (created_dir) fs::remove(out_dir, ec);
+      return report;
+    }
+    const std::string report_path = (out_dir / "report.json").string();
+    if (options.write_report)
+      write_text_file_atomically(transaction.stage(report_path), to_json(report).dump(2) + "\n");
+    transaction.commit();
+    for (const OutputReport& o : report.outputs) report.written.push_back(o.file);
+    if (options.write_report) report.written.push_back(report_path);
+    return report;
+  } catch (...) {
+    transaction.rollback();
+    if (created_dir) fs::remove(out_dir, ec);
+    throw;
+  }
+}
+
+}  // namespace lacuna

@@ -1,0 +1,183 @@
+// The lacunar plate and cell inputs (bcifs).
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "errors.h"
+#include "recipe/input_parsers.h"
+
+namespace lacuna {
+namespace {
+
+using namespace bcifs;
+
+constexpr double kPi = 3.14159265358979323846;
+
+FaceType parse_face(const JsonObject& f) {
+  f.allow_only({"boundary", "params", "algorithm", "delay", "control_mm", "bends_mm"});
+  FaceType face;
+  try {
+    face.boundary = parse_boundary(f.string("boundary"));
+  } catch (const InvalidInput& e) {
+    f.fail("boundary", e.what());
+  }
+  try {
+    face.edges = parse_edge_set(f.string_or("params", "C2 B2 B2"));
+  } catch (const InvalidInput& e) {
+    f.fail("params", e.what());
+  }
+  try {
+    face.algorithm = parse_algorithm(f.string_or("algorithm", "A1"));
+  } catch (const InvalidInput& e) {
+    f.fail("algorithm", e.what());
+  }
+  const uint64_t delay = f.unsigned_integer_or("delay", 1);
+  if (delay < 1 || delay > 16) f.fail("delay", "expected a delay from 1 to 16");
+  face.delay = int(delay);
+  try {
+    validate(face);
+  } catch (const InvalidInput& e) {
+    f.fail("", e.what());
+  }
+  return face;
+}
+
+std::vector<Vec2d> parse_control(const JsonObject& f, size_t edges, double radius) {
+  std::vector<Vec2d> control;
+  if (!f.has("control_mm")) {
+    if (radius <= 0) f.fail("control_mm", "expected one [x, y] per boundary edge (or \"radius_mm\" for a regular polygon)");
+    for (size_t j = 0; j < edges; ++j) {
+      const double a = 2 * kPi * double(j) / double(edges);
+      control.push_back({radius * std::cos(a), radius * std::sin(a)});
+    }
+    return control;
+  }
+  control = f.vec2_list(f.required("control_mm"), f.path_of("control_mm"));
+  if (control.size() != edges)
+    f.fail("control_mm", "expected " + std::to_string(edges) + " points (one per boundary edge), got " +
+                             std::to_string(control.size()));
+  if (!(signed_area(control) > 0)) f.fail("control_mm", "expected a counter-clockwise polygon of positive area");
+  return control;
+}
+
+// "bends_mm": one entry per edge, null for a straight edge or [x, y], the middle control point of the edge's
+// quadratic Bézier.
+std::vector<Bend> parse_bends(const JsonObject& f, size_t edges) {
+  std::vector<Bend> bends;
+  if (!f.has("bends_mm")) return bends;
+  const nlohmann::json& list = f.required("bends_mm");
+  if (!list.is_array() || list.size() != edges)
+    f.fail("bends_mm", "expected " + std::to_string(edges) + " entries (one per edge): null or [x, y]");
+  for (size_t j = 0; j < edges; ++j) {
+    if (list[j].is_null()) {
+      bends.emplace_back();
+      continue;
+    }
+    if (!list[j].is_array() || list[j].size() != 2 || !list[j][0].is_number() || !list[j][1].is_number())
+      f.fail("bends_mm", "entry " + std::to_string(j) + ": expected null or [x, y]");
+    bends.emplace_back(Vec2d{list[j][0].get<double>(), list[j][1].get<double>()});
+  }
+  return bends;
+}
+
+double fraction(const JsonObject& o, const char* key, double fallback) {
+  const double v = o.number_or(key, fallback);
+  if (!(v > 0 && v < 1)) o.fail(key, "expected a fraction strictly between 0 and 1");
+  return v;
+}
+
+}  // namespace
+
+BcifsPlateInput parse_bcifs_plate_input(const JsonObject& o) {
+  BcifsPlateInput in;
+  bcifs::PlateOptions& spec = in.plate;
+  if (o.has("face") == o.has("faces")) o.fail("", "give either \"face\" (one lacunar face) or \"faces\" (an assembly)");
+  const double radius = o.has("radius_mm") ? o.positive_length("radius_mm") : 0.0;
+  if (o.has("face")) {
+    if (o.has("shared")) o.fail("shared", "shared edges need \"faces\"");
+    const JsonObject f = o.object("face");
+    spec.assembly.faces.push_back(parse_face(f));
+    spec.controls.push_back(parse_control(f, spec.assembly.faces[0].boundary.size(), radius));
+    spec.bends.push_back(parse_bends(f, spec.assembly.faces[0].boundary.size()));
+  } else {
+    const nlohmann::json& list = o.required("faces");
+    if (!list.is_array() || list.empty()) o.fail("faces", "expected a list of faces");
+    for (size_t i = 0; i < list.size(); ++i) {
+      const JsonObject f(list[i], o.file(), o.path_of("faces") + "[" + std::to_string(i) + "]");
+      spec.assembly.faces.push_back(parse_face(f));
+      spec.controls.push_back(parse_control(f, spec.assembly.faces.back().boundary.size(), list.size() == 1 ? radius : 0));
+      spec.bends.push_back(parse_bends(f, spec.assembly.faces.back().boundary.size()));
+    }
+    if (o.has("shared")) {
+      const nlohmann::json& shared = o.required("shared");
+      if (!shared.is_array()) o.fail("shared", "expected a list of {face_a, edge_a, face_b, edge_b} (0-based)");
+      for (size_t i = 0; i < shared.size(); ++i) {
+        const JsonObject s(shared[i], o.file(), o.path_of("shared") + "[" + std::to_string(i) + "]");
+        s.allow_only({"face_a", "edge_a", "face_b", "edge_b"});
+        auto index = [&](const char* key) {
+          if (!s.has(key)) s.fail(key, "expected a 0-based index");
+          return int(std::min<uint64_t>(s.unsigned_integer_or(key, 0), 1u << 30));
+        };
+        SharedEdge e;
+        e.face_a = index("face_a");
+        e.edge_a = index("edge_a");
+        e.face_b = index("face_b");
+        e.edge_b = index("edge_b");
+        spec.assembly.shared.push_back(e);
+      }
+    }
+  }
+  try {
+    validate(spec.assembly);
+  } catch (const InvalidInput& e) {
+    o.fail(o.has("shared") ? "shared" : "", e.what());
+  }
+  const uint64_t level = o.unsigned_integer_or("level", 3);
+  if (level > 8) o.fail("level", "expected a level from 0 to 8");
+  spec.level = int(level);
+  spec.thickness_mm = o.positive_length_or("thickness_mm", 1.0);
+  spec.origin_mm = o.vec3_or("origin_mm", Vec3d{});
+  spec.options.defaults.gap_fraction = fraction(o, "gap_fraction", spec.options.defaults.gap_fraction);
+  spec.options.defaults.lacuna_scale = fraction(o, "lacuna_scale", spec.options.defaults.lacuna_scale);
+  spec.options.defaults.notch_depth = fraction(o, "notch_depth", spec.options.defaults.notch_depth);
+  in.faces_listed = o.has("faces");
+  return in;
+}
+
+BcifsCellInput parse_bcifs_cell_input(const JsonObject& o) {
+  BcifsCellInput in;
+  in.edge_mm = o.positive_length("edge_mm");
+  try {
+    in.cell = cell_kind_from_name(o.string("cell"));
+  } catch (const InvalidInput& e) {
+    o.fail("cell", e.what());
+  }
+  in.thickness_mm = o.positive_length("thickness_mm");
+  if (in.thickness_mm >= in.edge_mm / 4) o.fail("thickness_mm", "expected a wall thinner than a quarter of edge_mm");
+  in.center_mm = o.vec3_or("center_mm", Vec3d{});
+  const uint64_t level = o.unsigned_integer_or("level", 2);
+  if (level > 6) o.fail("level", "expected a level from 0 to 6");
+  in.level = int(level);
+  try {
+    in.edge = parse_edge(o.string_or("edge", "C2"));
+  } catch (const InvalidInput& e) {
+    o.fail("edge", e.what());
+  }
+  try {
+    in.params = parse_edge_set(o.string_or("params", "C2 B2 B2"));
+  } catch (const InvalidInput& e) {
+    o.fail("params", e.what());
+  }
+  try {
+    in.algorithm = parse_algorithm(o.string_or("algorithm", "A1"));
+  } catch (const InvalidInput& e) {
+    o.fail("algorithm", e.what());
+  }
+  RealizeOptions& options = in.options;
+  options.defaults.gap_fraction = fraction(o, "gap_fraction", options.defaults.gap_fraction);
+  options.defaults.lacuna_scale = fraction(o, "lacuna_scale", options.defaults.lacuna_scale);
+  options.defaults.notch_depth = fraction(o, "notch_depth", options.defaults.notch_depth);
+  return in;
+}
+}  // namespace lacuna
