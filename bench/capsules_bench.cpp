@@ -137,8 +137,9 @@ int run_bench(int argc, char** argv) {
   using namespace lacuna;
   CLI::App app{"Capsule benchmark: direct rasterization vs meshToLevelSet of a tube soup, and the whole recipe"};
   size_t count = 1000;
-  double radius = 0.5, step = 0.5, box = 20.0;
-  bool soup = false, full = false;
+  double radius = 0.5, step = 0.5, box = 0;
+  bool soup = false, full = false, only_recipe = false;
+  double recipe_simplify_mm = -1, reference_voxel_mm = 0;
   double simplify_mm = 0;
   bool hausdorff = false;
   int threads = 0;
@@ -146,17 +147,22 @@ int run_bench(int argc, char** argv) {
   app.add_option("--count", count, "Number of capsules (segments of the walk)");
   app.add_option("--radius", radius, "Tube radius in mm");
   app.add_option("--step", step, "Walk step (segment length) in mm");
-  app.add_option("--box", box, "Side of the cube the walk is reflected in, mm");
+  app.add_option("--box", box, "Side of the cube the walk is reflected in, mm (default 20 (N/1000)^(1/3): constant density)");
   app.add_flag("--soup", soup, "Also convert a tube triangle soup with meshToLevelSet");
   app.add_flag("--full", full, "Also run the whole recipe (rasterize, mesh, write STL, re-read, check)");
   app.add_option("--threads", threads, "Worker threads (default all)");
   app.add_flag("--hausdorff", hausdorff, "With --simplify: the sampled one-sided Hausdorff distances both ways");
   app.add_option("--simplify", simplify_mm, "Also time extraction with simplification to this deviation (mm), and its check");
   app.add_option("--out", out_dir, "Folder for the recipe run's output");
+  app.add_flag("--only-recipe", only_recipe, "With --full: skip the direct rasterization, so the peak memory is the recipe's");
+  app.add_option("--recipe-simplify", recipe_simplify_mm, "With --full: the recipe's simplify_mm (default: the recipe default)");
+  app.add_option("--reference-voxel", reference_voxel_mm,
+                 "With --full: also the volume at this finer voxel size (compact mesh at a fifth of it), and the recipe's difference");
   CLI11_PARSE(app, argc, argv);
   std::unique_ptr<tbb::global_control> limit;
   if (threads > 0) limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
 
+  if (!(box > 0)) box = 20.0 * std::cbrt(double(count) / 1000.0);
   const VolumeOptions options{radius / 6.0, 3.0};
   std::vector<Vec3d> points = random_walk(count, step, box, 7);
   GeometrySet set;
@@ -165,7 +171,7 @@ int run_bench(int argc, char** argv) {
                            {"voxel_size_mm", options.voxel_size_mm}};
 
   auto t0 = std::chrono::steady_clock::now();
-  Volume direct = rasterize_primitives(set, options);
+  Volume direct = only_recipe ? Volume() : rasterize_primitives(set, options);
   double direct_s = seconds_since(t0);
   result["direct_seconds"] = direct_s;
   result["direct_active_voxels"] = direct.active_voxel_count();
@@ -228,6 +234,7 @@ int run_bench(int argc, char** argv) {
                              {"voxel_size_mm", options.voxel_size_mm},
                              {"inputs", {{"walk", {{"type", "tubes"}, {"polylines", {polyline}}}}}},
                              {"outputs", {{{"of", "walk"}, {"file", "capsules.stl"}}}}};
+    if (recipe_simplify_mm >= 0) recipe["simplify_mm"] = recipe_simplify_mm;
     std::string recipe_path = (fs::path(out_dir) / "capsules.json").string();
     std::ofstream(recipe_path) << recipe.dump();
     RunOptions run_options;
@@ -240,6 +247,20 @@ int run_bench(int argc, char** argv) {
     result["recipe_triangles"] = r["outputs"][0]["triangles"];
     result["recipe_valid"] = r["valid"];
     result["recipe_memory_estimate_bytes"] = r["memory_estimate_bytes"];
+    result["recipe_peak_memory_bytes"] = r["peak_memory_bytes"];
+    result["recipe_volume_mm3"] = r["outputs"][0]["volume_mm3"];
+    result["recipe_extracted_triangles"] = r["outputs"][0]["extracted_triangles"];
+    result["recipe_stl_bytes"] = fs::file_size(fs::path(out_dir) / "out" / "capsules.stl");
+    if (reference_voxel_mm > 0) {
+      SimplifyOptions fine;
+      fine.max_deviation_mm = 0.2 * reference_voxel_mm;
+      const double reference =
+          check_mesh(extract_simplified_surface(rasterize_primitives(set, VolumeOptions{reference_voxel_mm, 3.0}), fine))
+              .volume_mm3;
+      result["reference_voxel_mm"] = reference_voxel_mm;
+      result["reference_volume_mm3"] = reference;
+      result["recipe_volume_error"] = (r["outputs"][0]["volume_mm3"].get<double>() - reference) / reference;
+    }
   }
   result["peak_memory_bytes"] = peak_memory_bytes();
   std::printf("%s\n", result.dump().c_str());

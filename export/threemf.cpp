@@ -1,7 +1,9 @@
-// 3MF reading and writing through lib3mf 1.8's C interface.
+// 3MF reading through lib3mf 1.8's C interface; writing with libzip (exact float32 coordinates).
 #include <sys/stat.h>
 
 #include <zip.h>
+
+#include <charconv>
 
 #include <algorithm>
 #include <cmath>
@@ -363,36 +365,6 @@ std::string content_uuid(uint64_t hash, uint64_t role) {
   return text;
 }
 
-// Where lib3mf's callback stream writes the package.
-struct MemorySink {
-  std::vector<unsigned char> bytes;
-  uint64_t position = 0;
-  bool failed = false;  // out of memory; later writes are dropped so that lib3mf unwinds cleanly
-};
-
-// lib3mf's write callback (0 means success).
-unsigned int sink_write(unsigned char* data, unsigned int size, void* user) {
-  auto* sink = static_cast<MemorySink*>(user);
-  if (sink->failed) return 0;
-  try {
-    if (sink->position + size > sink->bytes.size()) sink->bytes.resize(sink->position + size);
-  } catch (const std::bad_alloc&) {
-    sink->failed = true;
-    return 1;
-  }
-  std::memcpy(sink->bytes.data() + sink->position, data, size);
-  sink->position += size;
-  return 0;
-}
-
-// lib3mf's seek callback, to an absolute position (0 means success).
-unsigned int sink_seek(unsigned long long position, void* user) {
-  auto* sink = static_cast<MemorySink*>(user);
-  if (position > sink->bytes.size()) return 1;
-  sink->position = position;
-  return 0;
-}
-
 // lib3mf 1.8 writes metadata values into the XML without escaping them.
 std::string xml_escape(const std::string& text) {
   std::string out;
@@ -665,57 +637,126 @@ void write_3mf(const std::string& path, const std::vector<ThreeMfObject>& parts,
   for (const auto& [name, value] : info.metadata) hash = fnv1a(fnv1a(hash, name), value);
 
   const std::string where = cat("cannot write '", path, "'");
-  Handle model, writer;
-  check<IoError>(NMR::lib3mf_createmodel(model.out()), nullptr, where);
-  check<IoError>(NMR::lib3mf_model_setunit(model.get(), NMR::MODELUNIT_MILLIMETER), model.get(),
-                 where);
+  // The model is written here rather than by lib3mf 1.8, whose writer prints coordinates with six
+  // decimals, some off in the last one (89.57946014 as "89.579464"): every coordinate is printed in
+  // the shortest form that reads back to the same float32, so the file holds the mesh exactly.
+  std::string model;
+  model.reserve(256 + [&] {
+    size_t n = 0;
+    for (size_t i = 0; i < parts.size(); ++i) n += 48 * all_vertices[i].size() + 48 * all_triangles[i].size();
+    return n;
+  }());
+  model += "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n"
+           "<model xmlns=\"http://schemas.microsoft.com/3dmanufacturing/core/2015/02\" unit=\"millimeter\" "
+           "xml:lang=\"en-US\" xmlns:p=\"http://schemas.microsoft.com/3dmanufacturing/production/2015/06\">\n";
+  for (const auto& [name, value] : info.metadata)
+    model += cat("\t<metadata name=\"", name, "\">", xml_escape(value), "</metadata>\n");
+  model += "\t<resources>\n";
+  char number[32];
+  auto put_float = [&](float v) {
+    auto result = std::to_chars(number, number + sizeof number, v);
+    model.append(number, result.ptr);
+  };
+  auto put_index = [&](uint32_t v) {
+    auto result = std::to_chars(number, number + sizeof number, v);
+    model.append(number, result.ptr);
+  };
   for (size_t i = 0; i < parts.size(); ++i) {
-    Handle object, item;
-    check<IoError>(NMR::lib3mf_model_addmeshobject(model.get(), object.out()), model.get(), where);
-    check<IoError>(NMR::lib3mf_object_setnameutf8(object.get(), parts[i].name.c_str()),
-                   object.get(), where);
-    check<IoError>(NMR::lib3mf_meshobject_setgeometry(
-                       object.get(), all_vertices[i].data(), DWORD(all_vertices[i].size()),
-                       all_triangles[i].data(), DWORD(all_triangles[i].size())),
-                   object.get(), where);
-    check<IoError>(NMR::lib3mf_object_setuuidutf8(object.get(), content_uuid(hash, i == 0 ? 1 : 2 + 2 * i).c_str()),
-                   object.get(), where);
-    check<IoError>(NMR::lib3mf_model_addbuilditem(model.get(), object.get(), nullptr, item.out()),
-                   model.get(), where);
-    check<IoError>(NMR::lib3mf_builditem_setuuidutf8(item.get(), content_uuid(hash, i == 0 ? 2 : 3 + 2 * i).c_str()),
-                   item.get(), where);
+    model += cat("\t\t<object id=\"", i + 1, "\" name=\"", xml_escape(parts[i].name), "\" type=\"model\" p:UUID=\"",
+                 content_uuid(hash, i == 0 ? 1 : 2 + 2 * i), "\">\n\t\t\t<mesh>\n\t\t\t\t<vertices>\n");
+    for (const NMR::MODELMESHVERTEX& v : all_vertices[i]) {
+      model += "\t\t\t\t\t<vertex x=\"";
+      put_float(v.m_fPosition[0]);
+      model += "\" y=\"";
+      put_float(v.m_fPosition[1]);
+      model += "\" z=\"";
+      put_float(v.m_fPosition[2]);
+      model += "\" />\n";
+    }
+    model += "\t\t\t\t</vertices>\n\t\t\t\t<triangles>\n";
+    for (const NMR::MODELMESHTRIANGLE& t : all_triangles[i]) {
+      model += "\t\t\t\t\t<triangle v1=\"";
+      put_index(t.m_nIndices[0]);
+      model += "\" v2=\"";
+      put_index(t.m_nIndices[1]);
+      model += "\" v3=\"";
+      put_index(t.m_nIndices[2]);
+      model += "\" />\n";
+    }
+    model += "\t\t\t\t</triangles>\n\t\t\t</mesh>\n\t\t</object>\n";
   }
-  check<IoError>(NMR::lib3mf_model_setbuilduuidutf8(model.get(), content_uuid(hash, 3).c_str()),
-                 model.get(), where);
-  for (const auto& [name, value] : info.metadata) {
-    check<IoError>(
-        NMR::lib3mf_model_addmetadatautf8(model.get(), name.c_str(), xml_escape(value).c_str()),
-        model.get(), where);
+  model += cat("\t</resources>\n\t<build p:UUID=\"", content_uuid(hash, 3), "\">\n");
+  for (size_t i = 0; i < parts.size(); ++i)
+    model += cat("\t\t<item objectid=\"", i + 1, "\" p:UUID=\"", content_uuid(hash, i == 0 ? 2 : 3 + 2 * i), "\" />\n");
+  model += "\t</build>\n</model>\n";
+  static const std::string kContentTypes =
+      "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n"
+      "<Types xmlns=\"http://schemas.openxmlformats.org/package/2006/content-types\">\n"
+      "\t<Default Extension=\"model\" ContentType=\"application/vnd.ms-package.3dmanufacturing-3dmodel+xml\" />\n"
+      "\t<Default Extension=\"rels\" ContentType=\"application/vnd.openxmlformats-package.relationships+xml\" />\n"
+      "</Types>\n";
+  static const std::string kRelationships =
+      "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n"
+      "<Relationships xmlns=\"http://schemas.openxmlformats.org/package/2006/relationships\">\n"
+      "\t<Relationship Type=\"http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel\" "
+      "Target=\"/3D/3dmodel.model\" Id=\"rel0\" />\n"
+      "</Relationships>\n";
+
+  // The package is made in memory (entries with a fixed date, so identical meshes give identical
+  // bytes), then written to the file, every write checked; a partial file is removed.
+  zip_error_t error;
+  zip_error_init(&error);
+  zip_source_t* buffer = zip_source_buffer_create(nullptr, 0, 0, &error);
+  if (!buffer) throw ResourceLimit(where + ": out of memory for the package");
+  zip_source_keep(buffer);
+  std::unique_ptr<zip_source_t, void (*)(zip_source_t*)> owned(buffer, zip_source_free);
+  zip_t* archive = zip_open_from_source(buffer, ZIP_TRUNCATE, &error);
+  if (!archive) throw IoError(where + ": " + zip_error_strerror(&error));
+  auto fail = [&](const std::string& what) {
+    const std::string message = what + ": " + zip_strerror(archive);
+    zip_discard(archive);
+    throw IoError(where + ": " + message);
+  };
+  const std::pair<const char*, const std::string*> entries[] = {
+      {"3D/3dmodel.model", &model}, {"[Content_Types].xml", &kContentTypes}, {"_rels/.rels", &kRelationships}};
+  for (const auto& [name, text] : entries) {
+    zip_source_t* source = zip_source_buffer(archive, text->data(), text->size(), 0);
+    if (!source) fail(cat("cannot add ", name));
+    const zip_int64_t index = zip_file_add(archive, name, source, ZIP_FL_ENC_UTF_8);
+    if (index < 0) {
+      zip_source_free(source);
+      fail(cat("cannot add ", name));
+    }
+    if (zip_set_file_compression(archive, zip_uint64_t(index), ZIP_CM_DEFLATE, 6) != 0 ||
+        zip_file_set_dostime(archive, zip_uint64_t(index), 0, 0, 0) != 0)
+      fail(cat("cannot set up ", name));
   }
-  check<IoError>(NMR::lib3mf_model_querywriter(model.get(), "3mf", writer.out()), model.get(),
-                 where);
-  // lib3mf 1.8 aborts the process (an exception escapes a destructor) when its own file output
-  // fails, e.g. on a full disk; so it writes into memory and the file is written here.
-  MemorySink sink;
-  int result =
-      NMR::lib3mf_writer_writetocallback(writer.get(), reinterpret_cast<void*>(&sink_write),
-                                         reinterpret_cast<void*>(&sink_seek), &sink);
-  if (sink.failed) throw ResourceLimit(where + ": out of memory for the package");
-  check<IoError>(result, writer.get(), where);
+  if (zip_close(archive) != 0) fail("cannot make the package");
+  std::vector<unsigned char> bytes;
+  if (zip_source_open(buffer) != 0 || zip_source_seek(buffer, 0, SEEK_END) != 0)
+    throw IoError(where + ": cannot read the package back");
+  const zip_int64_t size = zip_source_tell(buffer);
+  bytes.resize(size_t(std::max<zip_int64_t>(size, 0)));
+  if (size < 0 || zip_source_seek(buffer, 0, SEEK_SET) != 0 ||
+      zip_source_read(buffer, bytes.data(), zip_uint64_t(bytes.size())) != size) {
+    zip_source_close(buffer);
+    throw IoError(where + ": cannot read the package back");
+  }
+  zip_source_close(buffer);
 
   std::FILE* file = std::fopen(path.c_str(), "wb");
   if (!file) throw IoError(cat("cannot create '", path, "': ", std::strerror(errno)));
-  bool written = std::fwrite(sink.bytes.data(), 1, sink.bytes.size(), file) == sink.bytes.size();
-  int error = errno;
+  bool written = std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size();
+  int write_error = errno;
   if (std::fclose(file) != 0 && written) {
     written = false;
-    error = errno;
+    write_error = errno;
   }
   if (!written) {
     // Remove the partial file, unless that is no regular file (say /dev/full).
     struct stat left;
     if (::stat(path.c_str(), &left) == 0 && S_ISREG(left.st_mode)) std::remove(path.c_str());
-    throw IoError(where + ": " + std::strerror(error));
+    throw IoError(where + ": " + std::strerror(write_error));
   }
 }
 

@@ -1,21 +1,17 @@
 #include "solids/components.h"
 
-#include "solids/disjoint_sets.h"
+#include "solids/mesh_topology.h"
 
 namespace lacuna {
 
 std::vector<MeshComponent> mesh_components(const TriMesh& m) {
-  DisjointSets sets(m.positions_mm.size());
-  for (const auto& t : m.triangles) {
-    sets.join(t[0], t[1]);
-    sets.join(t[1], t[2]);
-  }
-  std::vector<int> index(m.positions_mm.size(), -1);
+  const VertexComponents components = vertex_components(m);
+  std::vector<int> index(components.count, -1);  // by vertex component: the place in the output
   std::vector<MeshComponent> out;
   std::vector<Vec3d> moment;  // sum of det * (a + b + c), for the volume centroid
   for (uint32_t f = 0; f < m.triangles.size(); ++f) {
     const auto& t = m.triangles[f];
-    uint32_t root = sets.find(t[0]);
+    const uint32_t root = components.of_vertex[t[0]];
     if (index[root] < 0) {
       index[root] = int(out.size());
       out.emplace_back();

@@ -327,8 +327,8 @@ void BlockExtractor::extract(size_t i, SurfaceBlock& out) const {
   out.origin_voxels[2] = o.z();
   out.size_voxels = n;
   for (int k = 0; k < 3; ++k) {
-    out.box_mm.min[k] = round_to_float(double(o[k]) * m.h);
-    out.box_mm.max[k] = round_to_float(double(o[k] + n) * m.h);
+    out.box_mm.min[k] = round_to_output(double(o[k]) * m.h);
+    out.box_mm.max[k] = round_to_output(double(o[k] + n) * m.h);
   }
   out.positions_mm.clear();
   out.keys.clear();
@@ -363,7 +363,7 @@ void BlockExtractor::extract(size_t i, SurfaceBlock& out) const {
     const double t = std::clamp(double(f0) / (double(f0) - double(f1)), m.eps, 1.0 - m.eps);
     // The same expression as extract_surface, on global grid coordinates.
     const double gx = o.x() + px, gy = o.y() + py, gz = o.z() + pz;
-    out.positions_mm.push_back(round_to_float(Vec3d{(gx + t * dx) * m.h, (gy + t * dy) * m.h, (gz + t * dz) * m.h}));
+    out.positions_mm.push_back(round_to_output(Vec3d{(gx + t * dx) * m.h, (gy + t * dy) * m.h, (gz + t * dz) * m.h}));
     const bool on_boundary = (dx == 0 && (px == 0 || px == n)) || (dy == 0 && (py == 0 || py == n)) ||
                              (dz == 0 && (pz == 0 || pz == n));
     constexpr int64_t kBias = int64_t{1} << 19;

@@ -31,14 +31,17 @@ void bucket_by_vertex(size_t nv, size_t items, KeyOf&& key_of, ItemOf&& item_of,
 
 }  // namespace
 
-EdgeTopology edge_topology(const TriMesh& mesh) { return edge_topology(mesh, vertex_corners(mesh)); }
+EdgeTopology edge_topology(const TriMesh& mesh, bool with_partners) {
+  return edge_topology(mesh, vertex_corners(mesh), with_partners);
+}
 
-EdgeTopology edge_topology(const TriMesh& mesh, const VertexCorners& corners) {
+EdgeTopology edge_topology(const TriMesh& mesh, const VertexCorners& corners, bool with_partners) {
   const size_t nv = mesh.positions_mm.size(), nh = 3 * mesh.triangles.size();
   if (nh >= UINT32_MAX) throw std::length_error("a mesh with more than 1.4 billion triangles");
   EdgeTopology r;
   r.opposite.assign(nh, kNoHalfEdge);
   r.low_edges.assign(nv, 0);
+  if (with_partners) r.partner.assign(nh, kNoHalfEdge);
   struct Counts {
     uint64_t edges = 0, boundary = 0, non_manifold = 0, misoriented = 0;
   };
@@ -76,6 +79,10 @@ EdgeTopology edge_topology(const TriMesh& mesh, const VertexCorners& corners) {
           non_manifold[block].push_back(h);
         } else {
           const uint32_t g = uint32_t(keys[i + 1]);
+          if (with_partners) {
+            r.partner[h] = g;
+            r.partner[g] = h;
+          }
           if (half_edge_from(mesh, h) == half_edge_from(mesh, g)) {
             ++c.misoriented;
             misoriented[block].push_back(h);
@@ -168,9 +175,8 @@ std::vector<std::vector<uint32_t>> boundary_loops(const TriMesh& mesh, const Edg
   for (uint32_t h : edges.boundary) next[half_edge_from(mesh, h)] = half_edge_to(mesh, h);
   std::vector<std::vector<uint32_t>> loops;
   std::vector<uint8_t> seen(mesh.positions_mm.size(), 0);
-  for (uint32_t h : edges.boundary) {
-    const uint32_t start = half_edge_from(mesh, h);
-    if (seen[start]) continue;
+  for (uint32_t start = 0; start < next.size(); ++start) {
+    if (next[start] == UINT32_MAX || seen[start]) continue;
     std::vector<uint32_t> loop;
     for (uint32_t w = start; w != UINT32_MAX && !seen[w]; w = next[w]) {
       seen[w] = 1;

@@ -32,6 +32,9 @@ struct EdgeTopology {
   std::vector<uint32_t> boundary, non_manifold, misoriented;
   // Per vertex: the distinct edges whose smaller vertex it is (Euler characteristics per component).
   std::vector<uint32_t> low_edges;
+  // When asked for: the other half-edge of every edge with exactly two faces, whichever way they
+  // run it (repairs walk across misoriented edges too); kNoHalfEdge otherwise.
+  std::vector<uint32_t> partner;
 
   bool clean() const { return boundary_edges == 0 && non_manifold_edges == 0 && misoriented_edges == 0; }
 };
@@ -46,16 +49,16 @@ VertexCorners vertex_corners(const TriMesh& mesh);
 
 // Pairs the half-edges of the mesh (every index must name a vertex). Linear time, parallel,
 // the same result for any number of threads.
-EdgeTopology edge_topology(const TriMesh& mesh, const VertexCorners& corners);
-EdgeTopology edge_topology(const TriMesh& mesh);
+EdgeTopology edge_topology(const TriMesh& mesh, const VertexCorners& corners, bool with_partners = false);
+EdgeTopology edge_topology(const TriMesh& mesh, bool with_partners = false);
 
 // How many fans (faces around a vertex joined across paired edges) each vertex has: 1 for a
 // manifold vertex (interior or on the boundary), 0 for an unused one, more where fans only touch.
 std::vector<uint32_t> vertex_fans(const TriMesh& mesh, const EdgeTopology& edges, const VertexCorners& corners);
 
-// The boundary loops: each a list of vertices in the direction of its triangles' edges. Requires
-// a manifold boundary (no vertex where the boundary passes twice); returns them in order of their
-// smallest half-edge.
+// The boundary loops: each a list of vertices in the direction of its triangles' edges, starting
+// at its smallest vertex, the loops in order of those. Requires a manifold boundary (no vertex
+// where the boundary passes twice).
 std::vector<std::vector<uint32_t>> boundary_loops(const TriMesh& mesh, const EdgeTopology& edges);
 
 // Connected components through shared vertices: the component of every vertex (UINT32_MAX for

@@ -22,7 +22,7 @@
 #include <utility>
 
 #include "errors.h"
-#include "solids/disjoint_sets.h"
+#include "solids/mesh_topology.h"
 
 namespace lacuna {
 namespace {
@@ -81,12 +81,6 @@ struct Patch {
   std::vector<uint32_t> boundary;  // the boundary loop in the direction of its triangles' edges
 };
 
-struct HalfEdge {
-  uint64_t key;  // (min vertex << 32) | max vertex
-  uint32_t id;   // 3 * triangle + corner; runs from that corner to the next
-  bool operator<(const HalfEdge& o) const { return key != o.key ? key < o.key : id < o.id; }
-};
-
 // Checks that the mesh is a disk-like patch (throws InvalidInput naming the first problem found) and
 // returns it compacted, with its boundary loop.
 Patch disk_patch(const TriMesh& mesh) {
@@ -136,88 +130,58 @@ Patch disk_patch(const TriMesh& mesh) {
     }
   }
 
-  DisjointSets pieces(nv);
-  for (const auto& tri : patch.triangles) {
-    pieces.join(tri[0], tri[1]);
-    pieces.join(tri[0], tri[2]);
-  }
-  size_t components = 0;
-  for (uint32_t v = 0; v < nv; ++v) components += pieces.find(v) == v;
-  if (components != 1) {
-    throw InvalidInput("the patch has " + std::to_string(components) +
+  TriMesh indexed;
+  indexed.positions_mm = patch.positions;
+  indexed.triangles = patch.triangles;
+  const VertexComponents pieces = vertex_components(indexed);
+  if (pieces.count != 1) {
+    throw InvalidInput("the patch has " + std::to_string(pieces.count) +
                        " separate pieces (connected components); a disk-like patch is one piece");
   }
 
-  std::vector<HalfEdge> halfedges(3 * nt);
-  for (uint32_t t = 0; t < nt; ++t) {
-    for (uint32_t c = 0; c < 3; ++c) {
-      uint64_t a = patch.triangles[t][c], b = patch.triangles[t][(c + 1) % 3];
-      halfedges[3 * t + c] = {(std::min(a, b) << 32) | std::max(a, b), 3 * t + c};
-    }
-  }
-  std::sort(halfedges.begin(), halfedges.end());
-  auto from = [&](uint32_t id) { return patch.triangles[id / 3][id % 3]; };
-  auto to = [&](uint32_t id) { return patch.triangles[id / 3][(id % 3 + 1) % 3]; };
+  const VertexCorners corners = vertex_corners(indexed);
+  const EdgeTopology edges = edge_topology(indexed, corners);
+  auto from = [&](uint32_t h) { return half_edge_from(indexed, h); };
+  auto to = [&](uint32_t h) { return half_edge_to(indexed, h); };
   auto vertex_name = [&](uint32_t v) { return std::to_string(patch.original[v]) + " " + describe(patch.positions[v]); };
-  // Corners (3 * triangle + corner) around one vertex joined across the interior edges: one fan each.
-  DisjointSets fans(3 * nt);
-  std::vector<uint32_t> boundary_next(nv, kNone);
-  size_t edges = 0, boundary_edges = 0;
-  for (size_t i = 0; i < halfedges.size();) {
-    size_t j = i;
-    while (j < halfedges.size() && halfedges[j].key == halfedges[i].key) ++j;
-    ++edges;
-    uint32_t h = halfedges[i].id;
-    if (j - i > 2) {
-      throw InvalidInput("not manifold at edge between vertices " + vertex_name(from(h)) + " and " +
-                         vertex_name(to(h)) + ": " + std::to_string(j - i) + " triangles share it");
+  if (!edges.non_manifold.empty()) {
+    const uint32_t h = edges.non_manifold.front(), a = from(h), b = to(h);
+    size_t faces = 0;
+    for (const auto& tri : patch.triangles) {
+      const bool has_a = tri[0] == a || tri[1] == a || tri[2] == a, has_b = tri[0] == b || tri[1] == b || tri[2] == b;
+      faces += has_a && has_b;
     }
-    if (j - i == 1) {
-      ++boundary_edges;
-      if (boundary_next[from(h)] != kNone) {
-        throw InvalidInput("not manifold at vertex " + vertex_name(from(h)) +
-                           ": the boundary passes through it more than once");
-      }
-      boundary_next[from(h)] = to(h);
-    } else {
-      uint32_t g = halfedges[i + 1].id;
-      if (from(h) == from(g)) {
-        throw InvalidInput("inconsistently oriented at edge between vertices " + vertex_name(from(h)) + " and " +
-                           vertex_name(to(h)) + ": both its triangles run it the same way");
-      }
-      // h runs a -> b in its triangle, g runs b -> a in its own.
-      fans.join(h, 3 * (g / 3) + (g % 3 + 1) % 3);
-      fans.join(3 * (h / 3) + (h % 3 + 1) % 3, g);
+    throw InvalidInput("not manifold at edge between vertices " + vertex_name(a) + " and " + vertex_name(b) + ": " +
+                       std::to_string(faces) + " triangles share it");
+  }
+  if (!edges.misoriented.empty()) {
+    const uint32_t h = edges.misoriented.front();
+    throw InvalidInput("inconsistently oriented at edge between vertices " + vertex_name(from(h)) + " and " +
+                       vertex_name(to(h)) + ": both its triangles run it the same way");
+  }
+  std::vector<uint32_t> boundary_out(nv, 0);
+  for (uint32_t h : edges.boundary) {
+    if (boundary_out[from(h)]++) {
+      throw InvalidInput("not manifold at vertex " + vertex_name(from(h)) +
+                         ": the boundary passes through it more than once");
     }
-    i = j;
   }
-  std::vector<uint32_t> fan_count(nv, 0);
-  for (uint32_t corner = 0; corner < 3 * nt; ++corner) {
-    if (fans.find(corner) == corner) ++fan_count[patch.triangles[corner / 3][corner % 3]];
-  }
+  const std::vector<uint32_t> fans = vertex_fans(indexed, edges, corners);
   for (uint32_t v = 0; v < nv; ++v) {
-    if (fan_count[v] > 1) {
+    if (fans[v] > 1) {
       throw InvalidInput("not manifold at vertex " + vertex_name(v) + ": its triangles form " +
-                         std::to_string(fan_count[v]) + " fans that touch only there");
+                         std::to_string(fans[v]) + " fans that touch only there");
     }
   }
-  if (boundary_edges == 0) throw InvalidInput("the patch is closed: it has no boundary to flatten");
+  if (edges.boundary_edges == 0) throw InvalidInput("the patch is closed: it has no boundary to flatten");
 
-  size_t loops = 0;
-  std::vector<char> seen(nv, 0);
-  for (uint32_t v = 0; v < nv; ++v) {
-    if (boundary_next[v] == kNone || seen[v]) continue;
-    ++loops;
-    for (uint32_t w = v; !seen[w]; w = boundary_next[w]) {
-      seen[w] = 1;
-      if (loops == 1) patch.boundary.push_back(w);
-    }
+  const std::vector<std::vector<uint32_t>> loops = boundary_loops(indexed, edges);
+  if (loops.size() != 1) {
+    throw InvalidInput("the patch has " + std::to_string(loops.size()) + " boundary loops; a disk-like patch has one (" +
+                       std::to_string(loops.size() - 1) + " holes would have to be cut open or filled)");
   }
-  if (loops != 1) {
-    throw InvalidInput("the patch has " + std::to_string(loops) + " boundary loops; a disk-like patch has one (" +
-                       std::to_string(loops - 1) + " holes would have to be cut open or filled)");
-  }
-  int64_t euler = int64_t(nv) - int64_t(edges) + int64_t(nt);
+  patch.boundary = loops.front();
+  const int64_t euler = euler_characteristics(indexed, edges, pieces).front();
   if (euler != 1) {
     throw InvalidInput("the patch has Euler characteristic " + std::to_string(euler) +
                        " (vertices - edges + triangles), a disk-like patch has 1: it has " +

@@ -8,6 +8,7 @@
 
 #include "errors.h"
 #include "solids/components.h"
+#include "solids/mesh_topology.h"
 #include "solids/extract.h"
 #include "solids/rasterize.h"
 
@@ -61,12 +62,8 @@ TriMesh weld(const TriMesh& in, double tolerance) {
 // turned to enclose a positive volume.
 TriMesh reorient(const TriMesh& in) {
   TriMesh out = in;
-  std::map<std::pair<uint32_t, uint32_t>, std::vector<uint32_t>> edge_faces;
-  for (uint32_t f = 0; f < in.triangles.size(); ++f)
-    for (int k = 0; k < 3; ++k) {
-      uint32_t a = in.triangles[f][size_t(k)], b = in.triangles[f][size_t((k + 1) % 3)];
-      edge_faces[{std::min(a, b), std::max(a, b)}].push_back(f);
-    }
+  // The face across each edge of each face, from the input (flips keep a face's edges).
+  const EdgeTopology edges = edge_topology(in, true);
   auto runs = [](const std::array<uint32_t, 3>& t, uint32_t a, uint32_t b) {
     for (int k = 0; k < 3; ++k)
       if (t[size_t(k)] == a && t[size_t((k + 1) % 3)] == b) return true;
@@ -80,12 +77,14 @@ TriMesh reorient(const TriMesh& in) {
     while (!stack.empty()) {
       uint32_t f = stack.back();
       stack.pop_back();
-      for (int k = 0; k < 3; ++k) {
-        uint32_t a = out.triangles[f][size_t(k)], b = out.triangles[f][size_t((k + 1) % 3)];
-        const auto& faces = edge_faces[{std::min(a, b), std::max(a, b)}];
-        if (faces.size() != 2) continue;  // boundary or non-manifold: no neighbour to agree with
-        uint32_t g = faces[0] == f ? faces[1] : faces[0];
+      for (uint32_t k = 0; k < 3; ++k) {
+        const uint32_t across = edges.partner[3 * f + k];
+        if (across == kNoHalfEdge) continue;  // boundary or non-manifold: no neighbour to agree with
+        const uint32_t g = across / 3;
         if (done[g]) continue;
+        // The shared edge as face f runs it now.
+        const uint32_t a0 = in.triangles[f][k], b0 = in.triangles[f][(k + 1) % 3];
+        const uint32_t a = runs(out.triangles[f], a0, b0) ? a0 : b0, b = a == a0 ? b0 : a0;
         // The neighbour must run the shared edge the other way.
         if (runs(out.triangles[g], a, b)) std::swap(out.triangles[g][1], out.triangles[g][2]);
         done[g] = 1;

@@ -21,6 +21,15 @@ namespace {
 constexpr uint32_t kNone = UINT32_MAX;
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeviationMargin = 0.75;
+// A triangle's shape: 4 sqrt(3) area over the sum of its squared edges, 1 when equilateral, 0 when
+// flat; collapses may not push the worst triangle they touch below this (see RegionSimplifier::collapse).
+constexpr double kMinQuality = 0.15;
+
+double quality(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+  const Vec3d ab = b - a, bc = c - b, ca = a - c;
+  const double edges = dot(ab, ab) + dot(bc, bc) + dot(ca, ca);
+  return edges > 0 ? 2 * std::sqrt(3.0) * norm(cross(ab, -ca)) / edges : 0;
+}
 
 
 // Sum of weighted squared distances to planes: Q(p) = p'Ap + 2b'p + c, with the total weight w.
@@ -670,9 +679,9 @@ class RegionSimplifier {
       for (uint32_t c : new_fan_) n += cross(pos_[to(c)] - mid, pos_[from(prev_he(c))] - mid);
       Vec3d volume_target;
       if (q.minimiser_on_plane(mid, n, old6 + dot(n, mid), volume_target) &&
-          q.error(round_to_float(volume_target)) <= tolerance2_)
+          q.error(round_to_output(volume_target)) <= tolerance2_)
         target = volume_target;
-      target = round_to_float(target);
+      target = round_to_output(target);
       if (!box_.strictly_inside(target) || q.error(target) > tolerance2_) return false;
     } else if (!box_.strictly_inside(target)) {
       return false;
@@ -691,7 +700,12 @@ class RegionSimplifier {
       if (!near_new_fan(pos_[drop]) || (keep_moves && !near_new_fan(pos_[keep]))) return false;
     }
 
-    // The triangles that change: drop's (renamed), and keep's when keep moves.
+    // The triangles that change: drop's (renamed), and keep's when keep moves. None may be worse
+    // shaped than the worst it replaces unless it stays above kMinQuality: exact tests keep even a
+    // needle valid, but slicers, viewers and meshers recompute its normal in float and trip on it.
+    double old_quality = std::min(quality(pos_[tri_[t1][0]], pos_[tri_[t1][1]], pos_[tri_[t1][2]]),
+                                  quality(pos_[tri_[t2][0]], pos_[tri_[t2][1]], pos_[tri_[t2][2]]));
+    double new_quality = HUGE_VAL;
     changed_.clear();
     changed_ids_.clear();
     changed_pos_.clear();
@@ -707,11 +721,15 @@ class RegionSimplifier {
       const Vec3d n_old = cross(pos_[old[1]] - pos_[old[0]], pos_[old[2]] - pos_[old[0]]);
       const Vec3d n_new = cross(p[1] - p[0], p[2] - p[0]);
       if (dot(n_old, n_new) <= cos_normal_ * norm(n_old) * norm(n_new)) return false;
+      old_quality = std::min(old_quality, quality(pos_[old[0]], pos_[old[1]], pos_[old[2]]));
+      new_quality = std::min(new_quality, quality(p[0], p[1], p[2]));
       changed_.push_back(t);
       changed_ids_.push_back(ids);
       changed_pos_.push_back(p);
       changed_box_.push_back(tri_box(p));
     }
+
+    if (new_quality < std::min(kMinQuality, old_quality)) return false;
 
     // The new triangles stay near the old surface: each centroid, and the midpoint of every edge
     // from the new vertex, within the deviation of the old fans (vertex tests alone let a
@@ -1048,7 +1066,7 @@ TriMesh simplify_mesh(const TriMesh& mesh, const SimplifyOptions& options, Simpl
   SimplifyStats stats;
   stats.input_triangles = mesh.triangles.size();
   std::vector<Vec3d> positions(mesh.positions_mm.size());
-  for (size_t v = 0; v < positions.size(); ++v) positions[v] = round_to_float(mesh.positions_mm[v]);
+  for (size_t v = 0; v < positions.size(); ++v) positions[v] = round_to_output(mesh.positions_mm[v]);
   std::vector<std::array<uint32_t, 3>> triangles = mesh.triangles;
   Box3 box;
   double area = 0;

@@ -33,14 +33,15 @@ constexpr Vec3d cross(const Vec3d& a, const Vec3d& b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
 inline double norm(const Vec3d& v) { return std::sqrt(dot(v, v)); }
-// The nearest float32 value (what a binary STL or 3MF stores). Through a volatile float: GCC 12 at
-// -O3 with -frounding-math (which CGAL requires) was seen to drop a plain double(float(v)) on some
-// lanes of a Vec3d, leaving the double unrounded.
-inline double round_to_float(double v) {
+// A coordinate the output formats store exactly: the nearest float32 (binary STL keeps float32;
+// 3MF files are written with the shortest text that reads back to the same float32). Through a
+// volatile: GCC 12 at -O3 with -frounding-math (which CGAL requires) was seen to drop a plain
+// double(float(v)) on some lanes of a Vec3d.
+inline double round_to_output(double v) {
   volatile float f = float(v);
   return double(f);
 }
-inline Vec3d round_to_float(const Vec3d& v) { return {round_to_float(v.x), round_to_float(v.y), round_to_float(v.z)}; }
+inline Vec3d round_to_output(const Vec3d& v) { return {round_to_output(v.x), round_to_output(v.y), round_to_output(v.z)}; }
 inline bool is_finite(const Vec3d& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }

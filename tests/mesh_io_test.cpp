@@ -18,6 +18,7 @@
 #include "errors.h"
 #include "export/output_files.h"
 #include "geometry.h"
+#include "util/random.h"
 
 namespace lacuna {
 namespace {
@@ -412,6 +413,25 @@ TEST_F(MeshIoTest, ThreeMfRoundTripKeepsCoordinates) {
   EXPECT_EQ(back.positions_mm, mesh.positions_mm);
   EXPECT_EQ(back.triangles, mesh.triangles);
   EXPECT_NEAR(signed_volume(back), 4.0 / 3.0 * 2.5 * 2.5 * 2.5, 1e-12);
+}
+
+TEST_F(MeshIoTest, ThreeMfAndStlKeepEveryFloatCoordinate) {
+  // Coordinates from 1e-3 to 1e3 mm with every bit of a float32 in use (89.57946014 is one that
+  // six printed decimals would turn into another float): both formats read back bit for bit.
+  Random random(11);
+  TriMesh mesh;
+  for (int i = 0; i < 3000; ++i) {
+    const double scale = std::pow(10.0, double(random.next() % 7) - 3);
+    mesh.positions_mm.push_back(round_to_output(Vec3d{scale * (2 * random.uniform() - 1), scale * (2 * random.uniform() - 1),
+                                                      scale * (2 * random.uniform() - 1)}));
+  }
+  mesh.positions_mm.push_back(round_to_output(Vec3d{40.33958, 28.509774, -89.57946}));
+  while (mesh.positions_mm.size() % 3) mesh.positions_mm.push_back(Vec3d{1, 2, 3 + double(mesh.positions_mm.size())});
+  for (uint32_t i = 0; i + 2 < mesh.positions_mm.size(); i += 3) mesh.triangles.push_back({i, i + 1, i + 2});
+  write_3mf(path("floats.3mf"), mesh, {});
+  const TriMesh back = read_mesh(path("floats.3mf"));
+  EXPECT_EQ(back.positions_mm, mesh.positions_mm);
+  EXPECT_EQ(back.triangles, mesh.triangles);
 }
 
 TEST_F(MeshIoTest, ThreeMfComponentsTransformsAndUnits) {
