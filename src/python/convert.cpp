@@ -1,5 +1,7 @@
 #include "python/convert.h"
 
+#include <pybind11/stl.h>
+
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -176,6 +178,16 @@ std::vector<Vec3d> to_points(const py::handle& value, const std::string& what) {
   static_assert(sizeof(Vec3d) == 3 * sizeof(double), "Vec3d is three packed doubles");
   if (!points.empty()) std::memcpy(static_cast<void*>(points.data()), a.data(), points.size() * sizeof(Vec3d));
   return points;
+}
+
+Vec3d to_vec3(const py::handle& value, const std::string& what) {
+  std::vector<double> v;
+  try {
+    v = value.cast<std::vector<double>>();
+  } catch (const py::cast_error&) {
+  }
+  if (v.size() != 3) throw py::value_error(what + ": expected three numbers [x, y, z]");
+  return Vec3d{v[0], v[1], v[2]};
 }
 
 py::array_t<double> points_array(const std::vector<Vec3d>& points) {

@@ -54,6 +54,9 @@ py::object from_json(const nlohmann::json& value);
 // An N x 3 array of points (any real dtype) as points; throws ValueError naming `what` otherwise.
 std::vector<Vec3d> to_points(const py::handle& array, const std::string& what);
 
+// A point or direction of three numbers; throws ValueError naming `what` otherwise.
+Vec3d to_vec3(const py::handle& value, const std::string& what);
+
 // Points as a new N x 3 float64 array; 2D points as N x 2.
 py::array_t<double> points_array(const std::vector<Vec3d>& points);
 py::array_t<double> points_array(const std::vector<Vec2d>& points);

@@ -94,10 +94,8 @@ py::object check(const Mesh& mesh, bool printability, double min_wall_mm, double
   options.printability = printability;
   options.min_wall_mm = min_wall_mm;
   options.min_hole_mm = min_hole_mm;
-  const std::vector<Vec3d> up =
-      to_points(py::array_t<double>::ensure(build_direction).attr("reshape")(1, 3), "build_direction");
-  if (norm(up[0]) == 0) throw py::value_error("build_direction: expected a non-zero direction");
-  options.build_direction = up[0];
+  options.build_direction = to_vec3(build_direction, "build_direction");
+  if (!(norm(options.build_direction) > 0)) throw py::value_error("build_direction: expected a non-zero direction");
   options.critical_angle_deg = critical_angle_deg;
   options.voxel_size_mm = voxel_size_mm.is_none() ? 0.0 : voxel_size_mm.cast<double>();
   const FileCheck result = released([&] { return check_solid(*mesh.data, mesh.label, options); });

@@ -146,12 +146,10 @@ nlohmann::json keys_json(const std::string& type, const py::dict& keys,
   };
   nlohmann::json object = to_json(keys, "lacuna." + type, solids);
   if (!object.is_object()) throw py::type_error("lacuna." + type + ": expected keyword arguments");
-  for (const char* key : {"file", "mesh"}) {
-    const bool is_file = (std::string(key) == "file" && (type == "mesh" || type == "surface")) ||
-                         (std::string(key) == "mesh" && type == "curve");
-    if (is_file && object.contains(key) && object[key].is_string() && !object[key].get<std::string>().empty() &&
-        fs::path(object[key].get<std::string>()).is_relative())
-      object[key] = fs::absolute(object[key].get<std::string>()).string();
+  const char* file_key = type == "mesh" || type == "surface" ? "file" : type == "curve" ? "mesh" : nullptr;
+  if (file_key && object.contains(file_key) && object[file_key].is_string()) {
+    const std::string file = object[file_key].get<std::string>();
+    if (!file.empty() && fs::path(file).is_relative()) object[file_key] = fs::absolute(file).string();
   }
   return object;
 }

@@ -82,6 +82,11 @@ def test_check_is_the_command_line_report(tmp_path, cli):
     printed = lacuna.read_mesh(path).check(printability=True, min_wall_mm=0.5)
     code, out, err = cli("check", path, "--json", "--print", "--min-wall", 0.5)
     assert printed["printability"] == json.loads(out)["printability"]
+    down = lacuna.read_mesh(path).check(printability=True, build_direction=(1, 0, 0), critical_angle_deg=30)
+    code, out, err = cli("check", path, "--json", "--print", "--build-dir", "x", "--critical-angle", 30)
+    assert down["printability"] == json.loads(out)["printability"]
+    with pytest.raises(ValueError, match="build_direction"):
+        m.check(printability=True, build_direction=(0, 1))
 
 
 def test_check_finds_an_open_mesh():
