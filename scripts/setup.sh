@@ -4,8 +4,11 @@
 #
 #   scripts/setup.sh                      install and build
 #   scripts/setup.sh --run RECIPE [ARGS]  ... then `lacuna run RECIPE ARGS`
-#   scripts/setup.sh --test               ... with the test clients (PrusaSlicer, admesh, Gmsh, CalculiX), warnings
-#                                         as errors, then the whole test suite through CTest
+#   scripts/setup.sh --test               ... with the test clients (PrusaSlicer, admesh, Gmsh, CalculiX, pytest,
+#                                         meshio), warnings as errors, then the whole test suite through CTest
+#
+# The Python module is built for Debian's /usr/bin/python3 (where python3-numpy lives), whatever
+# python3 comes first on PATH; PYTHONPATH=build/python imports it from the build tree.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -22,10 +25,11 @@ esac
 packages=(build-essential cmake ninja-build ccache pkg-config
           libopenvdb-dev libboost-iostreams-dev libcgal-dev libgmp-dev libmpfr-dev libtet1.5-dev
           libdraco-dev lib3mf-dev libzip-dev libeigen3-dev libtbb-dev
-          nlohmann-json3-dev libcli11-dev libgtest-dev)
+          nlohmann-json3-dev libcli11-dev libgtest-dev
+          python3-dev pybind11-dev python3-numpy)
 if [ "$mode" = test ]; then
   # Real downstream clients the tests run the outputs through.
-  packages+=(prusa-slicer admesh gmsh calculix-ccx)
+  packages+=(prusa-slicer admesh gmsh calculix-ccx python3-pytest python3-meshio)
 fi
 
 missing=()
@@ -44,7 +48,8 @@ fi
 build_dir=build
 werror=OFF
 [ "$mode" = test ] && werror=ON
-cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release -DLACUNA_WERROR="$werror" >/dev/null
+cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release -DLACUNA_WERROR="$werror" \
+      -DPython_EXECUTABLE=/usr/bin/python3 >/dev/null
 # Two parallel compile jobs of the OpenVDB/CGAL translation units need about 5 GB.
 cmake --build "$build_dir" -j "$(nproc)"
 

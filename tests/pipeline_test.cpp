@@ -140,5 +140,35 @@ TEST(Pipeline, CancelledRunThrowsAndLeavesNothing) {
   EXPECT_FALSE(fs::exists(dir.path() / "out"));
 }
 
+// Asks to stop as soon as a stage reports its first step, from whichever thread reports it.
+class StopAtFirstStep : public ProgressSink {
+ public:
+  void begin(const std::string&, uint64_t) override {
+    ++begun;
+    began_after_stop = began_after_stop || done.load() > 0;
+  }
+  void advance(uint64_t n) override { done += n; }
+  void end() override { ++ends; }
+  bool cancelled() const override { return done.load() > 0; }
+
+  std::atomic<uint64_t> done{0};
+  size_t begun = 0, ends = 0;
+  bool began_after_stop = false;
+};
+
+TEST(Pipeline, CancellationStopsInsideAStage) {
+  TempDir dir;
+  std::ofstream(dir.path() / "ball.json") << kBallRecipe;
+  StopAtFirstStep sink;
+  RunOptions options;
+  options.output_dir = (dir.path() / "out").string();
+  options.progress = &sink;
+  EXPECT_THROW(run((dir.path() / "ball.json").string(), options), Cancelled);
+  EXPECT_GT(sink.done.load(), 0u);
+  EXPECT_FALSE(sink.began_after_stop);  // stopped within the stage that reported the step
+  EXPECT_EQ(sink.ends, sink.begun);
+  EXPECT_FALSE(fs::exists(dir.path() / "out"));
+}
+
 }  // namespace
 }  // namespace lacuna

@@ -15,6 +15,7 @@
 #include "cli/exit_codes.h"
 #include "errors.h"
 #include "pipeline/build_inputs.h"
+#include "pipeline/generators.h"
 #include "recipe/input_parsers.h"
 #include "recipe/json_fields.h"
 
@@ -104,23 +105,19 @@ int bcifs_measure(const BcifsArgs& a) {
     object.erase("type");
     const std::string path = "inputs." + name;
     const bcifs::Plate plate = build_plate(parse_bcifs_plate_input(JsonObject(object, a.recipe, path)), a.recipe, path);
-    const bcifs::PlateOptions& spec = plate.options;
+    const PlateMeasures measures = measure_plate(plate, lo, hi);
     nlohmann::json entry;
     nlohmann::json faces = nlohmann::json::array();
-    for (size_t f = 0; f < spec.assembly.faces.size(); ++f) {
-      const bcifs::Lacunarity l = bcifs::lacunarity(plate.rules, plate.rules.roots[f], hi);
-      faces.push_back({{"type", plate.rules.roots[f]}, {"subfaces", l.subfaces}, {"lacunas", l.lacunas},
+    for (size_t f = 0; f < measures.faces.size(); ++f) {
+      const bcifs::Lacunarity& l = measures.faces[f];
+      faces.push_back({{"type", measures.face_types[f]}, {"subfaces", l.subfaces}, {"lacunas", l.lacunas},
                        {"ratio", l.ratio}, {"r_limit", l.limit}, {"spectral_radius", l.spectral_radius}});
     }
     entry["topology"] = faces;
-    std::vector<bcifs::Leaf> faces_at_level_0;
-    for (auto& face : bcifs::realize_assembly(plate.rules, spec.assembly, spec.controls, 0, spec.options, spec.bends))
-      faces_at_level_0.insert(faces_at_level_0.end(), face.begin(), face.end());
-    std::vector<std::vector<Vec2d>> top_polygons;
-    const bcifs::GeometricMeasures m =
-        bcifs::geometric_measures(plate.rules, faces_at_level_0, lo, hi, spec.options, &top_polygons);
-    const bcifs::BoxCount region = bcifs::box_count_region(top_polygons);
-    const bcifs::BoxCount boundary = bcifs::box_count_segments(bcifs::boundary_segments(top_polygons));
+    const bcifs::GeometricMeasures& m = measures.geometry;
+    const std::vector<std::vector<Vec2d>>& top_polygons = measures.polygons;
+    const bcifs::BoxCount& region = measures.region;
+    const bcifs::BoxCount& boundary = measures.boundary;
     entry["levels"] = {lo, hi};
     entry["area_mm2"] = m.area;
     entry["perimeter_mm"] = m.perimeter;

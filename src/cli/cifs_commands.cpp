@@ -8,9 +8,9 @@
 
 #include "cifs/library.h"
 #include "cifs/nurbs.h"
-#include "cifs/tessellate.h"
 #include "cli/exit_codes.h"
 #include "errors.h"
+#include "pipeline/generators.h"
 #include "recipe/cifs_system.h"
 #include "recipe/json_fields.h"
 
@@ -76,44 +76,13 @@ int cifs_info(const CifsArgs& args) {
 int cifs_tessellate(const CifsArgs& args) {
   if (args.format != "json" && args.format != "csv" && args.format != "obj")
     throw InvalidInput("--format: expected json, csv or obj, got \"" + args.format + "\"");
-  cifs::Cifs c = cifs::load_system(args.system);
-  cifs::complete_primitives(c.automaton);
-  const uint64_t pieces = cifs::count_pieces(c.automaton, args.level);
-  if (pieces > 20'000'000)
-    throw ResourceLimit("level " + std::to_string(args.level) + " has " + std::to_string(pieces) +
-                        " pieces; printing more than 20 000 000 is refused, use a recipe to build the solid");
-  const int dimension = cifs::primitive_dimension(c.automaton.states[size_t(c.automaton.initial)].primitive);
-  std::vector<Vec3d> points;
-  std::vector<std::vector<uint32_t>> cells;  // polylines, triangles or cells as vertex lists
-  std::vector<std::vector<uint32_t>> faces;  // for obj: the faces of the cells
-  if (dimension == 1) {
-    for (const auto& line : cifs::tessellate_curves(c, args.level)) {
-      std::vector<uint32_t> ids;
-      for (const Vec3d& p : line) {
-        ids.push_back(uint32_t(points.size()));
-        points.push_back(p);
-      }
-      cells.push_back(ids);
-    }
-  } else if (dimension == 2) {
-    TriMesh mesh = cifs::tessellate_surface(c, args.level);
-    points = mesh.positions_mm;
-    for (const auto& t : mesh.triangles) cells.push_back({t[0], t[1], t[2]});
-  } else {
-    cifs::for_each_piece(c, args.level, [&](const cifs::Piece& piece) {
-      std::vector<uint32_t> ids;
-      for (Eigen::Index i = 0; i < piece.vertices->cols(); ++i) {
-        ids.push_back(uint32_t(points.size()));
-        points.push_back(Vec3d{(*piece.vertices)(0, i), (*piece.vertices)(1, i), (*piece.vertices)(2, i)});
-      }
-      for (const auto& face : cifs::primitive_faces(c.automaton.states[size_t(piece.state)])) {
-        std::vector<uint32_t> f;
-        for (int k : face) f.push_back(ids[size_t(k)]);
-        faces.push_back(f);
-      }
-      cells.push_back(ids);
-    });
-  }
+  const cifs::Cifs c = cifs::load_system(args.system);
+  const CifsTessellation t = tessellate_system(c, args.level);
+  const int dimension = t.dimension;
+  const uint64_t pieces = t.pieces;
+  const std::vector<Vec3d>& points = t.points_mm;
+  const std::vector<std::vector<uint32_t>>& cells = t.cells;  // polylines, triangles or cells as vertex lists
+  const std::vector<std::vector<uint32_t>>& faces = t.faces;  // for obj: the faces of the cells
   if (args.format == "json") {
     nlohmann::json j = {{"system", c.name}, {"level", args.level}, {"pieces", pieces}, {"points", nlohmann::json::array()}};
     for (const Vec3d& p : points) j["points"].push_back(point_json(p));
@@ -183,20 +152,11 @@ int nurbs_tessellate_command(const NurbsArgs& args) {
   if (!in) throw IoError(args.control_points + ": cannot open the control points file");
   std::ostringstream text;
   text << in.rdbuf();
-  nlohmann::json points = parse_json_text(text.str(), args.control_points);
-  // Through the system reader, which checks the knots and the points.
-  nlohmann::json system = {{"nurbs_curve", {{"degree", args.degree}, {"knots", knots}}}, {"control_points_mm", points}};
-  cifs::Cifs c = cifs::parse_system(system, args.control_points, "");
-  if (args.level < 0 || args.level > 24) throw InvalidInput("--level: expected 0 .. 24");
-  std::vector<std::vector<Vec3d>> lines = cifs::tessellate_curves(c, args.level);
+  const nlohmann::json points = parse_json_text(text.str(), args.control_points);
+  const NurbsCurvePoints curve = nurbs_curve_points(args.degree, knots, points, args.level, args.control_points);
   nlohmann::json out = {{"degree", args.degree}, {"level", args.level}, {"points", nlohmann::json::array()},
-                        {"parameters", nlohmann::json::array()}};
-  uint64_t i = 0;
-  for (const auto& line : lines)
-    for (const Vec3d& p : line) {
-      out["points"].push_back(point_json(p));
-      out["parameters"].push_back(cifs::nurbs_vertex_parameter(args.degree, knots, args.level, i++));
-    }
+                        {"parameters", curve.parameters}};
+  for (const Vec3d& p : curve.points_mm) out["points"].push_back(point_json(p));
   if (args.json) {
     std::cout << out.dump() << "\n";
   } else {

@@ -10,6 +10,7 @@
 #include "curves/sweep.h"
 #include "cli/exit_codes.h"
 #include "errors.h"
+#include "pipeline/generators.h"
 
 namespace lacuna {
 namespace {
@@ -38,52 +39,24 @@ curves::CurveKind kind_of(const std::string& kind) {
   throw InvalidInput("--kind: expected hilbert, sierpinski or hilbert3d, got \"" + kind + "\"");
 }
 
-// One polyline of the output: its order, its points in drawing order, whether it closes.
-struct Drawn {
-  int order;
-  std::vector<Vec3d> points;
-  bool closed;
-};
+CurveSurface surface_of(const std::string& surface) {
+  if (surface == "plane") return CurveSurface::kPlane;
+  if (surface == "sphere") return CurveSurface::kSphere;
+  if (surface == "cylinder") return CurveSurface::kCylinder;
+  if (surface == "torus") return CurveSurface::kTorus;
+  if (surface == "cone") return CurveSurface::kCone;
+  if (surface == "cube") return CurveSurface::kCube;
+  throw InvalidInput("--surface: expected plane, sphere, cylinder, torus, cone or cube, got \"" + surface + "\"");
+}
 
 int curve_points(const CurveArgs& args) {
   const std::vector<int> orders = parse_orders(args.orders);
-  std::vector<Drawn> drawn;
-  uint64_t total = 0;
-  auto keep = [&](int order, std::vector<Vec3d> points, bool closed) {
-    total += points.size();
-    if (total > 20'000'000) throw ResourceLimit("more than 20 000 000 points; ask for lower orders");
-    drawn.push_back(Drawn{order, std::move(points), closed});
-  };
-  if (args.kind == "hilbert3d") {
-    if (args.surface != "plane" && args.surface != "cube") throw InvalidInput("--surface: a 3D Hilbert curve fills the cube; it takes no surface");
-    for (const curves::Curve3& c : curves::superposition3d(orders)) keep(c.order, c.polyline.points, c.polyline.closed);
-  } else {
-    const curves::CurveKind kind = kind_of(args.kind);
-    curves::MapOptions options;
-    options.tolerance_mm = args.tolerance;
-    if (args.surface == "cube") {
-      for (int order : orders)
-        for (const curves::Polyline3& line : curves::cube_curve(kind, order, options)) keep(order, line.points, line.closed);
-    } else {
-      curves::SurfaceMap map;
-      if (args.surface == "sphere") map = curves::sphere_map();
-      else if (args.surface == "cylinder") map = curves::cylinder_map();
-      else if (args.surface == "torus") map = curves::torus_map();
-      else if (args.surface == "cone") map = curves::cone_map();
-      else if (args.surface != "plane")
-        throw InvalidInput("--surface: expected plane, sphere, cylinder, torus, cone or cube, got \"" + args.surface + "\"");
-      for (const curves::Curve2& c : curves::superposition(kind, orders)) {
-        if (args.surface == "plane") {
-          std::vector<Vec3d> points;
-          for (const Vec2d& p : c.polyline.points) points.push_back(Vec3d{p.x, p.y, 0});
-          keep(c.order, std::move(points), c.polyline.closed);
-        } else {
-          curves::Polyline3 line = curves::map_polyline(c.polyline, map, options);
-          keep(c.order, line.points, line.closed);
-        }
-      }
-    }
-  }
+  const bool hilbert3d = args.kind == "hilbert3d";
+  if (hilbert3d && args.surface != "plane" && args.surface != "cube")
+    throw InvalidInput("--surface: a 3D Hilbert curve fills the cube; it takes no surface");
+  const std::vector<DrawnCurve> drawn =
+      lacuna::curve_points(hilbert3d ? curves::CurveKind::kHilbert : kind_of(args.kind), hilbert3d, orders,
+                   surface_of(args.surface), args.tolerance);
   if (args.csv) {
     std::cout << "order,polyline,x,y,z\n";
     char line[160];
@@ -95,7 +68,7 @@ int curve_points(const CurveArgs& args) {
     return kExitOk;
   }
   nlohmann::json j = {{"kind", args.kind}, {"surface", args.surface}, {"orders", nlohmann::json::array()}};
-  for (const Drawn& d : drawn) {
+  for (const DrawnCurve& d : drawn) {
     nlohmann::json points = nlohmann::json::array();
     for (const Vec3d& p : d.points) points.push_back({p.x, p.y, p.z});
     j["orders"].push_back({{"order", d.order}, {"closed", d.closed}, {"points", std::move(points)}});
@@ -104,7 +77,7 @@ int curve_points(const CurveArgs& args) {
     std::cout << j.dump() << "\n";
     return kExitOk;
   }
-  for (const Drawn& d : drawn)
+  for (const DrawnCurve& d : drawn)
     std::printf("order %d: %zu points%s\n", d.order, d.points.size(), d.closed ? ", closed" : "");
   std::printf("(--json or --csv for the points)\n");
   return kExitOk;
@@ -112,23 +85,11 @@ int curve_points(const CurveArgs& args) {
 
 int curve_fill_rate(const CurveArgs& args) {
   if (!(args.width > 0)) throw InvalidInput("--width: expected a positive stroke width (the square has side 2)");
-  const std::vector<curves::Curve2> set = curves::superposition(kind_of(args.kind), parse_orders(args.orders));
-  const std::vector<curves::Polyline2> lines = curves::polylines_of(set);
-  double length = 0;
-  uint64_t segments = 0;
-  for (const curves::Polyline2& l : lines) {
-    const size_t n = l.points.size();
-    for (size_t i = 0; i + 1 < n + (l.closed ? 1 : 0); ++i) {
-      const Vec2d d = l.points[(i + 1) % n] - l.points[i];
-      length += std::hypot(d.x, d.y);
-      ++segments;
-    }
-  }
-  const double exact = curves::fill_rate_exact(lines, args.width), simple = curves::fill_rate_estimate(lines, args.width);
+  const CurveFillRate r = lacuna::curve_fill_rate(kind_of(args.kind), parse_orders(args.orders), args.width);
+  const uint64_t segments = r.segments;
+  const double length = r.length, exact = r.fill_rate, simple = r.fill_rate_simple;
   if (args.json) {
-    std::vector<int> orders;
-    for (const curves::Curve2& c : set) orders.push_back(c.order);
-    std::cout << nlohmann::json{{"kind", args.kind}, {"orders", orders}, {"width", args.width}, {"segments", segments},
+    std::cout << nlohmann::json{{"kind", args.kind}, {"orders", r.orders}, {"width", args.width}, {"segments", segments},
                                 {"length", length}, {"fill_rate", exact}, {"fill_rate_simple", simple}}
                      .dump(2)
               << "\n";

@@ -8,6 +8,7 @@
 
 #include "cli/exit_codes.h"
 #include "errors.h"
+#include "pipeline/generators.h"
 #include "voronoi/rules.h"
 #include "voronoi/walls.h"
 
@@ -93,14 +94,13 @@ int voronoi_rules(const VoronoiArgs& a) {
 
 int voronoi_cells(const VoronoiArgs& a) {
   const voronoi::Rules r = rules_of(a);
-  const voronoi::Level level = voronoi::generate_level(r, a.level);
-  const std::vector<double> measures = a.dimension == 2 ? voronoi::cell_measures_2d(level) : voronoi::cell_measures_3d(level);
-  // The walls between colours (with scaled children: the shifted ones make no lattice to reuse cells on).
+  const VoronoiCells cells = lacuna::voronoi_cells(r, a.level, a.children == "scaled");
+  const voronoi::Level& level = cells.level;
+  const std::vector<double>& measures = cells.measures;
   nlohmann::json walls = nullptr;
-  if (a.children == "scaled") {
-    const voronoi::Walls w = voronoi::extract_walls(r, level);
-    walls = {{"boundary_generators", w.boundary_generators}, {"facets", w.facets.size()}, {"measure", w.measure}};
-  }
+  if (cells.walls)
+    walls = {{"boundary_generators", cells.walls->boundary_generators}, {"facets", cells.walls->facets.size()},
+             {"measure", cells.walls->measure}};
   if (a.json) {
     std::cout << nlohmann::json{{"dimension", r.dimension}, {"d", r.d}, {"level", a.level}, {"points", level.points.size()},
                                 {"measures", measures}, {"limit_measures", r.limit_measures}, {"walls", walls}}

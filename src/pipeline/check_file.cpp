@@ -12,9 +12,12 @@
 namespace lacuna {
 
 FileCheck check_file(const std::string& path, const CheckFileOptions& options) {
+  return check_solid(read_mesh(path), path, options);
+}
+
+FileCheck check_solid(const TriMesh& mesh, const std::string& path, const CheckFileOptions& options) {
   FileCheck result;
   result.file = path;
-  const TriMesh mesh = read_mesh(path);
   result.check = check_mesh(mesh);
   if (!options.printability) return result;
   if (!result.check.closed()) throw InvalidInput(path + ": printability needs a closed mesh");

@@ -35,6 +35,9 @@ struct FileCheck {
 // file when it cannot be read, InvalidInput when printability is asked of a mesh that is not closed.
 FileCheck check_file(const std::string& path, const CheckFileOptions& options = {});
 
+// The same for a mesh in memory; `label` stands for the file in the report and in messages.
+FileCheck check_solid(const TriMesh& mesh, const std::string& label, const CheckFileOptions& options = {});
+
 // The check as JSON: check_report_json() with "file", and with the printability findings both under
 // "printability" and (trapped_voids, thin_walls, small_holes) at the top level.
 nlohmann::json to_json(const FileCheck& check);

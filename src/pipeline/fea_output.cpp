@@ -51,6 +51,10 @@ TetCheck write_tetrahedra(const std::string& mesh_path, const std::string& outpu
     simplify.max_deviation_mm = simplify_mm;
     surface = simplify_mesh(surface, simplify);
   }
+  return write_tetrahedra(surface, output_path, settings);
+}
+
+TetCheck write_tetrahedra(const TriMesh& surface, const std::string& output_path, const FeaSettings& settings) {
   FeaResult fea = make_fea_mesh(surface, settings);
   if (!fea.check.valid()) return fea.check;
   OutputTransaction transaction;

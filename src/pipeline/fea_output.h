@@ -38,6 +38,9 @@ FeaResult make_fea_mesh(const TriMesh& surface, const FeaSettings& settings,
 TetCheck write_tetrahedra(const std::string& mesh_path, const std::string& output_path, const FeaSettings& settings,
                           double simplify_mm = 0);
 
+// The same for a surface in memory (not simplified here).
+TetCheck write_tetrahedra(const TriMesh& surface, const std::string& output_path, const FeaSettings& settings);
+
 // The report entry of a tetrahedral output.
 nlohmann::json fea_report_json(const TetCheck& check);
 

@@ -28,7 +28,10 @@ Progress::~Progress() {
 }
 
 void Progress::advance(uint64_t n) {
-  if (sink_) sink_->advance(n);
+  if (!sink_) return;
+  sink_->advance(n);
+  // Parallel loops pass the exception on to the thread that started them.
+  throw_if_cancelled(sink_);
 }
 
 }  // namespace lacuna

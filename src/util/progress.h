@@ -19,7 +19,8 @@ class ProgressSink {
   virtual void advance(uint64_t n) = 0;
   // The innermost stage ends.
   virtual void end() = 0;
-  // Whether the caller wants the work stopped; stages then throw Cancelled at their next start.
+  // Whether the caller wants the work stopped; stages then throw Cancelled at their next start or
+  // step. Called from any thread, after every advance().
   virtual bool cancelled() const { return false; }
 };
 
@@ -44,7 +45,7 @@ void throw_if_cancelled(const ProgressSink* sink);
 
 // One stage's progress, reported to the sink current on the thread that creates it: begin on
 // construction (throwing Cancelled first when the sink asks to stop), end on destruction.
-// advance() may be called from any thread.
+// advance() may be called from any thread; it throws Cancelled when the sink asks to stop.
 class Progress {
  public:
   Progress(std::string stage, uint64_t total);

@@ -1,0 +1,171 @@
+#include "pipeline/generators.h"
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <utility>
+
+#include "cifs/nurbs.h"
+#include "cifs/tessellate.h"
+#include "errors.h"
+#include "recipe/cifs_system.h"
+
+namespace lacuna {
+
+CifsTessellation tessellate_system(cifs::Cifs system, int level) {
+  cifs::complete_primitives(system.automaton);
+  CifsTessellation t;
+  t.pieces = cifs::count_pieces(system.automaton, level);
+  if (t.pieces > kMaxListedPieces)
+    throw ResourceLimit("level " + std::to_string(level) + " has " + std::to_string(t.pieces) +
+                        " pieces; printing more than 20 000 000 is refused, use a recipe to build the solid");
+  t.dimension = cifs::primitive_dimension(system.automaton.states[size_t(system.automaton.initial)].primitive);
+  if (t.dimension == 1) {
+    for (const auto& line : cifs::tessellate_curves(system, level)) {
+      std::vector<uint32_t> ids;
+      for (const Vec3d& p : line) {
+        ids.push_back(uint32_t(t.points_mm.size()));
+        t.points_mm.push_back(p);
+      }
+      t.cells.push_back(std::move(ids));
+    }
+  } else if (t.dimension == 2) {
+    TriMesh mesh = cifs::tessellate_surface(system, level);
+    t.points_mm = std::move(mesh.positions_mm);
+    for (const auto& tri : mesh.triangles) t.cells.push_back({tri[0], tri[1], tri[2]});
+  } else {
+    cifs::for_each_piece(system, level, [&](const cifs::Piece& piece) {
+      std::vector<uint32_t> ids;
+      for (Eigen::Index i = 0; i < piece.vertices->cols(); ++i) {
+        ids.push_back(uint32_t(t.points_mm.size()));
+        t.points_mm.push_back(Vec3d{(*piece.vertices)(0, i), (*piece.vertices)(1, i), (*piece.vertices)(2, i)});
+      }
+      for (const auto& face : cifs::primitive_faces(system.automaton.states[size_t(piece.state)])) {
+        std::vector<uint32_t> f;
+        for (int k : face) f.push_back(ids[size_t(k)]);
+        t.faces.push_back(std::move(f));
+      }
+      t.cells.push_back(std::move(ids));
+    });
+  }
+  return t;
+}
+
+NurbsCurvePoints nurbs_curve_points(int degree, const std::vector<double>& knots, const nlohmann::json& control_points,
+                                    int level, const std::string& file) {
+  // Through the system reader, which checks the knots and the points.
+  const nlohmann::json system = {{"nurbs_curve", {{"degree", degree}, {"knots", knots}}},
+                                 {"control_points_mm", control_points}};
+  const cifs::Cifs c = cifs::parse_system(system, file, "");
+  if (level < 0 || level > 24) throw InvalidInput("level: expected 0 .. 24, got " + std::to_string(level));
+  NurbsCurvePoints out;
+  uint64_t i = 0;
+  for (const auto& line : cifs::tessellate_curves(c, level))
+    for (const Vec3d& p : line) {
+      out.points_mm.push_back(p);
+      out.parameters.push_back(cifs::nurbs_vertex_parameter(degree, knots, level, i++));
+    }
+  return out;
+}
+
+std::vector<DrawnCurve> curve_points(curves::CurveKind kind, bool hilbert3d, const std::vector<int>& orders,
+                                     CurveSurface surface, double tolerance) {
+  std::vector<DrawnCurve> drawn;
+  uint64_t total = 0;
+  auto keep = [&](int order, std::vector<Vec3d> points, bool closed) {
+    total += points.size();
+    if (total > 20'000'000) throw ResourceLimit("more than 20 000 000 points; ask for lower orders");
+    drawn.push_back(DrawnCurve{order, closed, std::move(points)});
+  };
+  if (hilbert3d) {
+    if (surface != CurveSurface::kPlane && surface != CurveSurface::kCube)
+      throw InvalidInput("a 3D Hilbert curve fills the cube; it takes no surface");
+    for (const curves::Curve3& c : curves::superposition3d(orders)) keep(c.order, c.polyline.points, c.polyline.closed);
+    return drawn;
+  }
+  curves::MapOptions options;
+  options.tolerance_mm = tolerance;
+  if (surface == CurveSurface::kCube) {
+    for (int order : orders)
+      for (const curves::Polyline3& line : curves::cube_curve(kind, order, options))
+        keep(order, line.points, line.closed);
+    return drawn;
+  }
+  curves::SurfaceMap map;
+  switch (surface) {
+    case CurveSurface::kSphere:
+      map = curves::sphere_map();
+      break;
+    case CurveSurface::kCylinder:
+      map = curves::cylinder_map();
+      break;
+    case CurveSurface::kTorus:
+      map = curves::torus_map();
+      break;
+    case CurveSurface::kCone:
+      map = curves::cone_map();
+      break;
+    default:
+      break;
+  }
+  for (const curves::Curve2& c : curves::superposition(kind, orders)) {
+    if (surface == CurveSurface::kPlane) {
+      std::vector<Vec3d> points;
+      for (const Vec2d& p : c.polyline.points) points.push_back(Vec3d{p.x, p.y, 0});
+      keep(c.order, std::move(points), c.polyline.closed);
+    } else {
+      curves::Polyline3 line = curves::map_polyline(c.polyline, map, options);
+      keep(c.order, line.points, line.closed);
+    }
+  }
+  return drawn;
+}
+
+CurveFillRate curve_fill_rate(curves::CurveKind kind, const std::vector<int>& orders, double width) {
+  if (!(width > 0)) throw InvalidInput("expected a positive stroke width (the square has side 2)");
+  const std::vector<curves::Curve2> set = curves::superposition(kind, orders);
+  const std::vector<curves::Polyline2> lines = curves::polylines_of(set);
+  CurveFillRate r;
+  for (const curves::Curve2& c : set) r.orders.push_back(c.order);
+  for (const curves::Polyline2& l : lines) {
+    const size_t n = l.points.size();
+    for (size_t i = 0; i + 1 < n + (l.closed ? 1 : 0); ++i) {
+      const Vec2d d = l.points[(i + 1) % n] - l.points[i];
+      r.length += std::hypot(d.x, d.y);
+      ++r.segments;
+    }
+  }
+  r.fill_rate = curves::fill_rate_exact(lines, width);
+  r.fill_rate_simple = curves::fill_rate_estimate(lines, width);
+  return r;
+}
+
+VoronoiCells voronoi_cells(const voronoi::Rules& rules, int level, bool scaled_children) {
+  if (level < 0 || level > 12) throw InvalidInput("level: expected 0 .. 12, got " + std::to_string(level));
+  VoronoiCells c;
+  c.level = voronoi::generate_level(rules, level);
+  c.measures = rules.dimension == 2 ? voronoi::cell_measures_2d(c.level) : voronoi::cell_measures_3d(c.level);
+  // Shifted children make no lattice to reuse cells on.
+  if (scaled_children) c.walls = voronoi::extract_walls(rules, c.level);
+  return c;
+}
+
+PlateMeasures measure_plate(const bcifs::Plate& plate, int first, int last) {
+  if (first < 0 || last < first || last > 8)
+    throw InvalidInput("levels: expected 0 <= first <= last <= 8, got " + std::to_string(first) + ".." +
+                       std::to_string(last));
+  const bcifs::PlateOptions& spec = plate.options;
+  PlateMeasures m;
+  for (size_t f = 0; f < spec.assembly.faces.size(); ++f) {
+    m.face_types.push_back(plate.rules.roots[f]);
+    m.faces.push_back(bcifs::lacunarity(plate.rules, plate.rules.roots[f], last));
+  }
+  std::vector<bcifs::Leaf> faces_at_level_0;
+  for (auto& face : bcifs::realize_assembly(plate.rules, spec.assembly, spec.controls, 0, spec.options, spec.bends))
+    faces_at_level_0.insert(faces_at_level_0.end(), face.begin(), face.end());
+  m.geometry = bcifs::geometric_measures(plate.rules, faces_at_level_0, first, last, spec.options, &m.polygons);
+  m.region = bcifs::box_count_region(m.polygons);
+  m.boundary = bcifs::box_count_segments(bcifs::boundary_segments(m.polygons));
+  return m;
+}
+
+}  // namespace lacuna

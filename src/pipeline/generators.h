@@ -1,0 +1,105 @@
+// The generator commands as functions: what `lacuna cifs tessellate`, `curve points|fill-rate`,
+// `voronoi rules|cells` and `bcifs measure` compute, as plain data, for the command line and the
+// Python module. Names given as text (kinds, surfaces, groups) are parsed by each front end, which
+// names its own option in messages.
+#pragma once
+
+#include <cstdint>
+#include <nlohmann/json_fwd.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bcifs/plate.h"
+#include "bcifs/realize.h"
+#include "bcifs/topology.h"
+#include "cifs/automaton.h"
+#include "curves/curves.h"
+#include "geometry.h"
+#include "voronoi/rules.h"
+#include "voronoi/walls.h"
+
+namespace lacuna {
+
+// A system's pieces at a level: curves as polylines, surfaces as triangles, volumes as cells.
+struct CifsTessellation {
+  int dimension = 1;    // of the pieces: 1, 2 or 3
+  uint64_t pieces = 0;  // accepted words of the level
+  std::vector<Vec3d> points_mm;
+  std::vector<std::vector<uint32_t>> cells;  // polylines, triangles or cells, as indices into points_mm
+  std::vector<std::vector<uint32_t>> faces;  // volumes: every cell's faces, as indices into points_mm
+};
+
+// The most pieces a tessellation is listed with; beyond, a recipe builds the solid as a stream.
+constexpr uint64_t kMaxListedPieces = 20'000'000;
+
+// Tessellates the system (its primitives completed) at `level`. Throws ResourceLimit beyond
+// kMaxListedPieces pieces, before enumerating them.
+CifsTessellation tessellate_system(cifs::Cifs system, int level);
+
+// One NURBS piece evaluated through its automaton: 2^level + 1 points and their parameters.
+struct NurbsCurvePoints {
+  std::vector<Vec3d> points_mm;
+  std::vector<double> parameters;
+};
+
+// The piece of `degree` with its 2 degree knots and control points (a JSON list of degree + 1 points
+// [x, y, z], or [x, y, z, w] for a rational curve) at `level` (0 to 24). Throws InvalidInput naming
+// `file` for bad knots or points, and for a level out of range.
+NurbsCurvePoints nurbs_curve_points(int degree, const std::vector<double>& knots, const nlohmann::json& control_points,
+                                    int level, const std::string& file);
+
+// The surfaces curves are drawn on by curve_points().
+enum class CurveSurface { kPlane, kSphere, kCylinder, kTorus, kCone, kCube };
+
+// One drawn polyline: its order, whether it closes, its points in drawing order.
+struct DrawnCurve {
+  int order = 0;
+  bool closed = false;
+  std::vector<Vec3d> points;
+};
+
+// The superimposed curves of `orders` in the square (-1, 1)^2 (z = 0) or mapped onto a unit surface
+// with chords within `tolerance` of it; `hilbert3d` draws the 3D Hilbert curves in the cube (-1, 1)^3
+// and takes the plane or the cube as its surface. Throws InvalidInput for a 3D curve on another
+// surface, ResourceLimit beyond 20 000 000 points.
+std::vector<DrawnCurve> curve_points(curves::CurveKind kind, bool hilbert3d, const std::vector<int>& orders,
+                                     CurveSurface surface, double tolerance);
+
+// The fraction of the square (-1, 1)^2 the strokes of width `width` along the curves cover.
+struct CurveFillRate {
+  std::vector<int> orders;
+  uint64_t segments = 0;
+  double length = 0;            // of every polyline, units of the square
+  double fill_rate = 0;         // the area of the union of the strokes over the square's
+  double fill_rate_simple = 0;  // length x width / 4
+};
+
+// Throws InvalidInput unless width > 0.
+CurveFillRate curve_fill_rate(curves::CurveKind kind, const std::vector<int>& orders, double width);
+
+// A fractal Voronoi level's cell measures per colour and, with scaled children, its walls.
+struct VoronoiCells {
+  voronoi::Level level;
+  std::vector<double> measures;         // area (2D) or volume (3D) of each colour's cells, torus units
+  std::optional<voronoi::Walls> walls;  // with scaled children
+};
+
+// The rules' level `level`, measured. Throws InvalidInput for a level out of 0 to 12.
+VoronoiCells voronoi_cells(const voronoi::Rules& rules, int level, bool scaled_children);
+
+// What `bcifs measure` finds for one plate between two levels.
+struct PlateMeasures {
+  std::vector<bcifs::Lacunarity> faces;      // per face of the assembly, its counts at levels 0 .. last
+  std::vector<int> face_types;               // per face, its type in the rule set
+  bcifs::GeometricMeasures geometry;         // areas and perimeters of levels first .. last
+  bcifs::BoxCount region;                    // box counting of the region at the last level
+  bcifs::BoxCount boundary;                  // and of its boundary
+  std::vector<std::vector<Vec2d>> polygons;  // the sub-faces of the last level (mm)
+};
+
+// Measures the plate between levels `first` and `last` (0 <= first <= last <= 8). Throws InvalidInput
+// for other levels.
+PlateMeasures measure_plate(const bcifs::Plate& plate, int first, int last);
+
+}  // namespace lacuna

@@ -1,0 +1,91 @@
+"""lacuna.run and lacuna.voxelize: recipes given as paths, JSON text or dicts, the same outputs as
+`lacuna run`, and solids that build the same grids as their recipes."""
+
+import json
+import os
+
+import numpy as np
+import pytest
+
+import lacuna
+from conftest import write_json
+
+RECIPE = {
+    "voxel_size_mm": 0.15,
+    "inputs": {
+        "block": {"type": "box", "center_mm": [0, 0, 0], "size_mm": [12, 8, 5]},
+        "bore": {"type": "cylinder", "center_mm": [-2, 0, 0], "radius_mm": 2, "height_mm": 6},
+    },
+    "operations": [{"name": "cut", "op": "difference", "of": ["block", "bore"]}],
+    "outputs": [{"of": "cut", "file": "cut.stl"}, {"of": "cut", "file": "cut.3mf"}],
+}
+
+
+def without_times(report):
+    r = {k: v for k, v in report.items()
+         if k not in ("stage_seconds", "total_seconds", "peak_memory_bytes", "peak_memory_children_bytes",
+                      "memory_budget_bytes", "recipe", "threads", "valid", "written")}
+    r["outputs"] = [{k: v for k, v in o.items() if k != "file"} for o in report["outputs"]]
+    return r
+
+
+def test_run_gives_the_command_line_report(tmp_path, cli):
+    path = write_json(tmp_path / "part.json", RECIPE)
+    code, out, err = cli("run", path, "-o", tmp_path / "cli", "--json")
+    assert code == 0, err
+    expected = json.loads(out)
+    result = lacuna.run(path, output_dir=tmp_path / "py")
+    assert result.report["valid"] is True
+    assert without_times(result.report) == without_times(expected)
+    assert sorted(os.listdir(tmp_path / "py")) == ["cut.3mf", "cut.stl", "report.json"]
+    assert (tmp_path / "py" / "cut.stl").read_bytes() == (tmp_path / "cli" / "cut.stl").read_bytes()
+    meshes = result.meshes
+    assert sorted(meshes) == ["cut.3mf", "cut.stl"]
+    entry = result.report["outputs"][0]
+    assert meshes["cut.stl"].faces.shape[0] == entry["triangles"]
+    assert meshes["cut.stl"].volume_mm3 == pytest.approx(entry["volume_mm3"], rel=1e-9)
+    assert meshes["cut.stl"].genus == entry["genus"] == 1
+
+
+def test_dicts_and_json_text(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    from_dict = lacuna.run(RECIPE)
+    assert (tmp_path / "recipe-out" / "cut.stl").exists()  # no file: the part is called "recipe"
+    from_text = lacuna.run(json.dumps(RECIPE), output_dir="text", voxel_size_mm=0.15, threads=1)
+    assert without_times(from_dict.report) == without_times(from_text.report)
+    smaller = lacuna.run(dict(RECIPE, name="part"), voxel_size_mm=0.3, write_report=False)
+    assert smaller.report["voxel_size_mm"] == 0.3
+    assert sorted(os.listdir(tmp_path / "part-out")) == ["cut.3mf", "cut.stl"]
+
+
+def test_solid_builds_the_grid_of_its_recipe(tmp_path):
+    path = write_json(tmp_path / "part.json", RECIPE)
+    from_recipe = lacuna.voxelize(path)
+    solid = lacuna.box(size_mm=[12, 8, 5]) - lacuna.cylinder(center_mm=[-2, 0, 0], radius_mm=2, height_mm=6)
+    from_solid = solid.voxelize(voxel_size_mm=0.15)
+    assert from_recipe.active_voxels == from_solid.active_voxels
+    rng = np.random.default_rng(1)
+    points = rng.uniform(-7, 7, size=(2000, 3))
+    assert np.array_equal(from_recipe.distance(points), from_solid.distance(points))
+    assert lacuna.voxelize(path, object="bore").active_voxels < from_recipe.active_voxels
+
+
+def test_solid_recipe_runs_to_the_same_mesh(tmp_path):
+    solid = lacuna.sphere(radius_mm=2) | lacuna.capsule(a_mm=[0, 0, 0], b_mm=[4, 0, 0], radius_mm=0.8)
+    mesh = solid.mesh(voxel_size_mm=0.1)
+    recipe = solid.to_recipe(name="part", voxel_size_mm=0.1)
+    assert json.loads(json.dumps(recipe)) == recipe
+    result = lacuna.run(recipe, output_dir=tmp_path)
+    written = result.meshes["part.stl"]
+    assert written.faces.shape == mesh.faces.shape
+    assert written.volume_mm3 == pytest.approx(mesh.volume_mm3, rel=1e-9)
+    # The same numbers through the Mesh: checks pass and match the report.
+    assert result.report["outputs"][0]["checks"]["valid"]
+    assert mesh.check()["valid"]
+
+
+def test_relative_mesh_files_are_read_from_where_the_solid_was_made(tmp_path, monkeypatch, source_dir):
+    monkeypatch.chdir(source_dir / "samples")
+    hull = lacuna.mesh(file="meshes/egg_hull.stl")
+    monkeypatch.chdir(tmp_path)
+    assert hull.voxelize(voxel_size_mm=0.5).active_voxels > 0
