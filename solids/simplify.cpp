@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <numeric>
+#include <tuple>
 
 #include "errors.h"
 #include "solids/exact.h"
@@ -233,7 +234,7 @@ class RegionSimplifier {
     for (size_t v = 0; v < nv; ++v) {
       const uint32_t g = global_vertex_[v];
       pos_[v] = positions[g];
-      if (has_quadric[g]) {
+      if (has_quadric[g]) {  // moved in the first pass: stays put, keeps its quadric for collapses into it
         quadric_[v] = carried[g];
         own_quadric_[v] = 1;
       }
@@ -317,7 +318,7 @@ class RegionSimplifier {
   void store_global(std::vector<Vec3d>& positions, std::vector<Quadric>& quadrics, std::vector<uint8_t>& has_quadric,
                     std::vector<std::array<uint32_t, 3>>& out_tris) const {
     for (size_t v = 0; v < pos_.size(); ++v) {
-      if (locked_[v]) continue;
+      if (!moved_[v]) continue;
       const uint32_t g = global_vertex_[v];
       positions[g] = pos_[v];
       quadrics[g] = quadric_[v];
@@ -345,7 +346,7 @@ class RegionSimplifier {
       out.positions.push_back(pos_[v]);
       out.keys.push_back(block.keys[v]);
       out.quadrics.push_back(quadric_[v]);
-      out.has_quadric.push_back(locked_[v] ? 0 : 1);
+      out.has_quadric.push_back(moved_[v]);
     }
     for (size_t i = 0; i < tri_.size(); ++i)
       if (tri_alive_[i]) out.triangles.push_back({index[tri_[i][0]], index[tri_[i][1]], index[tri_[i][2]]});
@@ -378,6 +379,9 @@ class RegionSimplifier {
     touch_state_.assign(nv, kUnknownAxis);
     touch_checked_.assign(nv, 0);
     touch_now_ = 0;
+    moved_.assign(nv, 0);
+    represented_.resize(nv);
+    represented_count_.assign(nv, 0);
     for (size_t i = 0; i < nt; ++i)
       for (int k = 0; k < 3; ++k) {
         const uint32_t v = tri_[i][size_t(k)];
@@ -442,7 +446,7 @@ class RegionSimplifier {
     const size_t nv = pos_.size();
     locked_.assign(nv, 0);
     for (size_t v = 0; v < nv; ++v)
-      if (!box_.strictly_inside(pos_[v])) locked_[v] = 1;
+      if (!box_.strictly_inside(pos_[v]) || own_quadric_[v]) locked_[v] = 1;
     for (const auto& t : tri_) {
       if (box_.in_closed(pos_[t[0]]) && box_.in_closed(pos_[t[1]]) && box_.in_closed(pos_[t[2]])) continue;
       locked_[t[0]] = locked_[t[1]] = locked_[t[2]] = 1;
@@ -690,14 +694,63 @@ class RegionSimplifier {
     // The points that leave the surface (drop, and keep's old place when it moves) stay within
     // the deviation of the new fan: plane distances alone miss a spike folded into its base.
     {
+      // A triangle of the new fan the point is near (its id), or kNone.
       auto near_new_fan = [&](const Vec3d& point) {
         for (uint32_t c : new_fan_)
           if (within_deviation(point, target, at(rename(to(c)), keep, target),
                                at(rename(from(prev_he(c))), keep, target)))
-            return true;
-        return false;
+            return tri_of(c);
+        return kNone;
       };
-      if (!near_new_fan(pos_[drop]) || (keep_moves && !near_new_fan(pos_[keep]))) return false;
+      // With the points removed earlier that keep and drop stand for: otherwise many small moves
+      // could carry the surface away from a point no single collapse moved far.
+      removed_.clear();
+      removed_.push_back({pos_[drop], kNone});
+      if (keep_moves) removed_.push_back({pos_[keep], kNone});
+      for (uint32_t v : {keep, drop})
+        for (uint8_t i = 0; i < represented_count_[v]; ++i) removed_.push_back(represented_[v][i]);
+      for (Represented& point : removed_)
+        if ((point.near = near_new_fan(point.at)) == kNone) return false;
+      // The neighbours' fans change too (drop renamed, keep moved): the points they stand for stay
+      // within the deviation of what remains of their fans.
+      auto ring_keeps_points = [&](uint32_t r) {
+        if (r == keep || r == drop || represented_count_[r] == 0) return true;
+        bool walked = false;
+        for (uint8_t i = 0; i < represented_count_[r]; ++i) {
+          Represented& point = represented_[r][i];
+          // The triangle it was last found near first: usually still near, or untouched.
+          const uint32_t last = point.near;
+          if (last != kNone && last != t1 && last != t2 && tri_alive_[last]) {
+            const auto& t = tri_[last];
+            if ((t[0] == r || t[1] == r || t[2] == r) &&
+                within_deviation(point.at, at(rename(t[0]), keep, target), at(rename(t[1]), keep, target),
+                                 at(rename(t[2]), keep, target)))
+              continue;
+          }
+          if (!walked) {
+            ring_corners_.clear();
+            if (!walk_fan(r, nullptr, &ring_corners_)) return false;
+            walked = true;
+          }
+          point.near = kNone;
+          for (uint32_t c : ring_corners_) {
+            const uint32_t t = tri_of(c);
+            if (t == t1 || t == t2) continue;
+            if (within_deviation(point.at, pos_[r], at(rename(to(c)), keep, target),
+                                 at(rename(from(prev_he(c))), keep, target))) {
+              point.near = t;
+              break;
+            }
+          }
+          if (point.near == kNone) return false;
+        }
+        return true;
+      };
+      for (uint32_t r : drop_ring_)
+        if (!ring_keeps_points(r)) return false;
+      if (keep_moves)
+        for (uint32_t r : keep_ring_)
+          if (!ring_keeps_points(r)) return false;
     }
 
     // The triangles that change: drop's (renamed), and keep's when keep moves. None may be worse
@@ -880,6 +933,16 @@ class RegionSimplifier {
     degree_[b] -= 1;
     pos_[keep] = target;
     quadric_[keep] += quadric_[drop];
+    moved_[keep] = 1;
+    // keep stands for the removed points farthest from it from now on.
+    std::sort(removed_.begin(), removed_.end(), [&](const Represented& ru, const Represented& rw) {
+      const Vec3d &u = ru.at, &w = rw.at;
+      const Vec3d du = u - target, dw = w - target;
+      const double lu = dot(du, du), lw = dot(dw, dw);
+      return lu != lw ? lu > lw : std::tie(u.x, u.y, u.z) < std::tie(w.x, w.y, w.z);
+    });
+    represented_count_[keep] = uint8_t(std::min<size_t>(removed_.size(), kRepresented));
+    for (uint8_t i = 0; i < represented_count_[keep]; ++i) represented_[keep][i] = removed_[i];
     ++version_[keep];
     ++version_[drop];
     graph_axis_[keep] = keep_state;
@@ -917,7 +980,15 @@ class RegionSimplifier {
   std::vector<uint32_t> grid_version_, stamp_;
   uint32_t stamp_now_ = 0;
   std::vector<uint32_t> drop_corners_, drop_ring_, keep_corners_, keep_ring_, keep_ring_after_, new_fan_, changed_,
-      touched_, fan_scratch_;
+      touched_, fan_scratch_, ring_corners_;
+  static constexpr size_t kRepresented = 2;  // removed points a vertex stands for, checked at every later collapse
+  std::vector<uint8_t> moved_, represented_count_;
+  struct Represented {
+    Vec3d at;
+    uint32_t near;  // a triangle it was last found within the deviation of (a hint, always re-tested)
+  };
+  std::vector<std::array<Represented, kRepresented>> represented_;
+  std::vector<Represented> removed_;
   std::vector<uint32_t> touch_stamp_;
   std::vector<uint8_t> touch_state_, touch_checked_;
   uint32_t touch_now_ = 0;

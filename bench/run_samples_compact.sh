@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# Every sample run twice, plain (--simplify 0: the marching-tetrahedra surface) and compact (the
+# recipe's default simplification): per surface file its size, triangles, and how long PrusaSlicer
+# takes to load it (`prusa-slicer --info`, wall time), plus each run's total time. Prints a Markdown
+# table. Usage: bench/run_samples_compact.sh [BUILD_DIR] [SAMPLE ...]   (default: build, every sample)
+set -euo pipefail
+build="${1:-build}"
+shift || true
+samples=("$@")
+if [ "${#samples[@]}" -eq 0 ]; then
+  for f in samples/*.json; do samples+=("$(basename "$f" .json)"); done
+fi
+command -v prusa-slicer >/dev/null || { echo "prusa-slicer is not installed" >&2; exit 2; }
+out="$(mktemp -d)"
+trap 'rm -rf "$out"' EXIT
+echo "| sample | file | plain triangles | plain size | plain load | plain run | compact triangles | compact size | compact load | compact run |"
+echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
+for s in "${samples[@]}"; do
+  for mode in plain compact; do
+    args=()
+    [ "$mode" = plain ] && args=(--simplify 0)
+    "$build/lacuna" run "samples/$s.json" -o "$out/$s-$mode" --quiet --json "${args[@]}" > "$out/$s-$mode.json"
+  done
+  /usr/bin/python3 - "$out" "$s" <<'EOF'
+import json, os, subprocess, sys, time
+out, s = sys.argv[1], sys.argv[2]
+rows = {}
+for mode in ("plain", "compact"):
+    report = json.load(open(f"{out}/{s}-{mode}.json"))
+    for o in report["outputs"]:
+        path = f"{out}/{s}-{mode}/{o['file']}"
+        if not o["file"].endswith((".stl", ".3mf")):
+            continue
+        start = time.monotonic()
+        subprocess.run(["prusa-slicer", "--info", path], check=True, capture_output=True)
+        load = time.monotonic() - start
+        rows.setdefault(o["file"], {})[mode] = (o["triangles"], os.path.getsize(path), load, report["total_seconds"])
+for f, r in rows.items():
+    p, c = r["plain"], r["compact"]
+    print(f"| {s} | {f} | {p[0]:,} | {p[1] / 1e6:.1f} MB | {p[2]:.2f} s | {p[3]:.1f} s | {c[0]:,} | {c[1] / 1e6:.1f} MB | {c[2]:.2f} s | {c[3]:.1f} s |".replace(",", " "))
+EOF
+done
