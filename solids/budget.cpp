@@ -30,6 +30,10 @@ uint64_t band_voxels(double surface_area_mm2, const Box3& box, const VolumeOptio
   return saturate(std::min(from_area, from_box));
 }
 
+double compact_mesh_share(double simplify_mm, double voxel_size_mm) {
+  return simplify_mm >= 0.1 * voxel_size_mm ? 0.45 : 1.0;
+}
+
 MemoryEstimate estimate_from_voxels(uint64_t active_voxels, const VolumeOptions& options) {
   (void)options;
   MemoryEstimate e;

@@ -234,7 +234,7 @@ class RegionSimplifier {
     for (size_t v = 0; v < nv; ++v) {
       const uint32_t g = global_vertex_[v];
       pos_[v] = positions[g];
-      if (has_quadric[g]) {  // moved in the first pass: stays put, keeps its quadric for collapses into it
+      if (has_quadric[g]) {  // moved in the first pass: its quadric carries the planes merged into it
         quadric_[v] = carried[g];
         own_quadric_[v] = 1;
       }
@@ -446,7 +446,7 @@ class RegionSimplifier {
     const size_t nv = pos_.size();
     locked_.assign(nv, 0);
     for (size_t v = 0; v < nv; ++v)
-      if (!box_.strictly_inside(pos_[v]) || own_quadric_[v]) locked_[v] = 1;
+      if (!box_.strictly_inside(pos_[v])) locked_[v] = 1;
     for (const auto& t : tri_) {
       if (box_.in_closed(pos_[t[0]]) && box_.in_closed(pos_[t[1]]) && box_.in_closed(pos_[t[2]])) continue;
       locked_[t[0]] = locked_[t[1]] = locked_[t[2]] = 1;

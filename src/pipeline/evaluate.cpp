@@ -60,8 +60,9 @@ Estimate estimate(const Recipe& recipe, const Plan& plan, const BuiltInputs& inp
   };
   std::map<std::string, Object> objects;
   Estimate total;
-  auto mesh_of = [&](uint64_t voxels) {
+  auto mesh_of = [&](uint64_t voxels, double simplify_mm = 0) {
     MemoryEstimate m = estimate_from_voxels(voxels, vopt);
+    m.mesh_bytes = uint64_t(double(m.mesh_bytes) * compact_mesh_share(simplify_mm, vopt.voxel_size_mm));
     if (m.mesh_bytes > total.mesh_bytes) {
       total.mesh_bytes = m.mesh_bytes;
       total.triangles = m.triangles;
@@ -108,7 +109,7 @@ Estimate estimate(const Recipe& recipe, const Plan& plan, const BuiltInputs& inp
     objects[name] = o;
   }
   for (const RecipeOutput& out : recipe.outputs)
-    for (const std::string& name : members(out)) mesh_of(objects[name].voxels);
+    for (const std::string& name : members(out)) mesh_of(objects[name].voxels, simplify_deviation_mm(recipe, out));
   return total;
 }
 

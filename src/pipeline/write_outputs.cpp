@@ -139,7 +139,12 @@ RunReport write_outputs(const Recipe& recipe, const Plan& plan, Evaluation&& eva
       throw_if_cancelled(sink);
       timer.start("mesh");
       Volume volume = evaluation.take(object);
-      detail::require_mesh_memory(volume, budget, recipe.file + ": meshing \"" + object + "\"", vopt);
+      double smallest_deviation = HUGE_VAL;
+      for (const RecipeOutput& out : recipe.outputs)
+        if (out.object == object || std::find(out.group.begin(), out.group.end(), object) != out.group.end())
+          smallest_deviation = std::min(smallest_deviation, simplify_deviation_mm(recipe, out));
+      detail::require_mesh_memory(volume, budget, recipe.file + ": meshing \"" + object + "\"", vopt,
+                                  std::isfinite(smallest_deviation) ? smallest_deviation : 0);
       std::optional<PrintabilityFindings> printability;
       if (recipe.printability.enabled) {
         timer.start("printability");

@@ -23,8 +23,11 @@ std::string refusal(const std::string& what, uint64_t need, uint64_t budget, con
          " (now " + fixed(vopt.voxel_size_mm, 4) + " mm)";
 }
 
-void require_mesh_memory(const Volume& v, uint64_t budget, const std::string& what, const VolumeOptions& vopt) {
-  uint64_t need = estimate_from_voxels(v.active_voxel_count(), vopt).mesh_bytes + current_memory_bytes();
+void require_mesh_memory(const Volume& v, uint64_t budget, const std::string& what, const VolumeOptions& vopt,
+                         double simplify_mm) {
+  const double mesh = double(estimate_from_voxels(v.active_voxel_count(), vopt).mesh_bytes) *
+                      compact_mesh_share(simplify_mm, vopt.voxel_size_mm);
+  uint64_t need = uint64_t(mesh) + current_memory_bytes();
   if (need > budget) throw ResourceLimit(refusal(what, need, budget, vopt));
 }
 

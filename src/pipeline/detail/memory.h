@@ -18,7 +18,9 @@ std::string refusal(const std::string& what, uint64_t need, uint64_t budget, con
 
 // Throws ResourceLimit before meshing a level set whose mesh and checks would not fit next to what is
 // in use now.
-void require_mesh_memory(const Volume& v, uint64_t budget, const std::string& what, const VolumeOptions& vopt);
+// simplify_mm: the smallest deviation the mesh is simplified to (0: the plain mesh).
+void require_mesh_memory(const Volume& v, uint64_t budget, const std::string& what, const VolumeOptions& vopt,
+                         double simplify_mm = 0);
 
 }  // namespace detail
 }  // namespace lacuna
