@@ -28,13 +28,13 @@ rows = {}
 for mode in ("plain", "compact"):
     report = json.load(open(f"{out}/{s}-{mode}.json"))
     for o in report["outputs"]:
-        path = f"{out}/{s}-{mode}/{o['file']}"
-        if not o["file"].endswith((".stl", ".3mf")):
+        path = o["file"]
+        if not path.endswith((".stl", ".3mf")):
             continue
         start = time.monotonic()
         subprocess.run(["prusa-slicer", "--info", path], check=True, capture_output=True)
         load = time.monotonic() - start
-        rows.setdefault(o["file"], {})[mode] = (o["triangles"], os.path.getsize(path), load, report["total_seconds"])
+        rows.setdefault(os.path.basename(path), {})[mode] = (o["triangles"], os.path.getsize(path), load, report["total_seconds"])
 for f, r in rows.items():
     p, c = r["plain"], r["compact"]
     print(f"| {s} | {f} | {p[0]:,} | {p[1] / 1e6:.1f} MB | {p[2]:.2f} s | {p[3]:.1f} s | {c[0]:,} | {c[1] / 1e6:.1f} MB | {c[2]:.2f} s | {c[3]:.1f} s |".replace(",", " "))
