@@ -5,6 +5,10 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <csignal>
+#include <cstdlib>
+#include <cstring>
+#include <thread>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -22,6 +26,7 @@
 #include "cli/voronoi_commands.h"
 #include "errors.h"
 #include "export/fea.h"
+#include "export/output_files.h"
 #include "export/report.h"
 #include "pipeline/pipeline.h"
 #include "util/progress.h"
@@ -192,9 +197,37 @@ int command_fea(const FeaArgs& args, const RunOptions& base, const CommonFlags& 
   return kExitOk;
 }
 
+// SIGINT and SIGTERM end the program after the files of unfinished outputs are removed: both are
+// blocked in every thread (threads started later inherit the mask), and one thread waits for them,
+// cleans up outside any signal handler, and ends the process by the signal's default action.
+void handle_interruptions() {
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  if (pthread_sigmask(SIG_BLOCK, &signals, nullptr) != 0) return;
+  std::thread([signals] {
+    int signal = 0;
+    if (sigwait(&signals, &signal) != 0) return;
+    remove_unfinished_outputs();
+    const char* message = signal == SIGINT ? "lacuna: interrupted; unfinished outputs removed\n"
+                                           : "lacuna: terminated; unfinished outputs removed\n";
+    if (::write(STDERR_FILENO, message, std::strlen(message)) < 0) {
+    }
+    std::signal(signal, SIG_DFL);
+    sigset_t one;
+    sigemptyset(&one);
+    sigaddset(&one, signal);
+    pthread_sigmask(SIG_UNBLOCK, &one, nullptr);
+    std::raise(signal);
+    std::_Exit(128 + signal);
+  }).detach();
+}
+
 }  // namespace
 
 int run_app(int argc, char** argv) {
+  handle_interruptions();
   CLI::App app{"Lacuna: volumetric solid modeling for additive manufacturing.\n"
                "Runs recipe files (JSON) into checked, printable STL and 3MF parts.\n"
                "Exit codes: 0 success, 2 bad usage or input, 3 resource limit, 4 failed validity check."};
@@ -299,7 +332,9 @@ int run_app(int argc, char** argv) {
     std::cerr << "lacuna: error: " << e.what() << "\n";
     return exit_code(e);
   } catch (const std::bad_alloc& e) {
-    std::cerr << "lacuna: error: out of memory; use a larger voxel size or a lower --max-memory estimate\n";
+    // The estimates made before allocating missed this one, so the cause is not known here.
+    std::cerr << "lacuna: error: out of memory: the machine could not give this job what it asked for; use coarser "
+                 "settings (voxel size, tolerances, levels, counts) or a smaller input\n";
     return exit_code(e);
   } catch (const std::exception& e) {
     std::cerr << "lacuna: internal error: " << e.what() << "\n";

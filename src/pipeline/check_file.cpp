@@ -47,12 +47,15 @@ FileCheck check_solid(const TriMesh& mesh, const std::string& path, const CheckF
   // by half the sizes asked about, the closing grows the box by as much.
   const uint64_t budget = options.max_memory_bytes ? options.max_memory_bytes : available_memory_bytes() / 2;
   const VolumeOptions plain{h, 3.0};
-  const double reach = 0.5 * std::max(options.min_wall_mm, options.min_hole_mm);
+  // (An erosion deeper than half the part's smallest side is not made: everything is a thin wall.)
+  const Vec3d size = result.check.bounding_box.size();
+  const double hole_reach = 0.5 * options.min_hole_mm;
+  const double reach = std::max(std::min(0.5 * options.min_wall_mm, 0.5 * std::min({size.x, size.y, size.z})), hole_reach);
   VolumeOptions wide = plain;
   wide.half_band_voxels += reach / h;
   Box3 box = result.check.bounding_box;
-  box.min -= Vec3d{reach, reach, reach} * (options.min_hole_mm > 0 ? 1.0 : 0.0);
-  box.max += Vec3d{reach, reach, reach} * (options.min_hole_mm > 0 ? 1.0 : 0.0);
+  box.min -= Vec3d{hole_reach, hole_reach, hole_reach};
+  box.max += Vec3d{hole_reach, hole_reach, hole_reach};
   const double area = surface_area(mesh);
   const MemoryEstimate grids = estimate_from_voxels(band_voxels(area, box, wide), wide);
   const MemoryEstimate surface = estimate_from_voxels(band_voxels(area, result.check.bounding_box, plain), plain);
@@ -60,7 +63,8 @@ FileCheck check_solid(const TriMesh& mesh, const std::string& path, const CheckF
   if (!(need <= double(budget)))
     throw ResourceLimit(path + ": the printability analysis at a voxel size of " + message_number(h) + " mm needs about " +
                         (need < 1e18 ? format_bytes(uint64_t(need)) : std::string("more than 1000000000 GB")) +
-                        ", more than the budget of " + format_bytes(budget) + "; use a larger --voxel-size");
+                        ", more than the budget of " + format_bytes(budget) +
+                        "; use a larger voxel size or a smaller minimum hole");
   PrintabilityOptions analysis;
   analysis.min_wall_mm = options.min_wall_mm;
   analysis.min_hole_mm = options.min_hole_mm;
