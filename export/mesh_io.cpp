@@ -921,6 +921,16 @@ TriMesh read_ply(InputFile& file, const ReadOptions& options) {
       }
     }
   }
+  // More records than the header declares mean a header that does not describe the file.
+  const std::string declared = cat("the header declares ", vertex->count, " vertices and ", face->count, " faces");
+  if (format == PlyFormat::kAscii) {
+    while (file.read_line(line)) {
+      split(line, tokens);
+      if (!tokens.empty()) bad(cat("more data than ", declared, ": '", excerpt(line), "'"));
+    }
+  } else if (file.offset() != file.size()) {
+    fail(path, cat(file.size() - file.offset(), " bytes after the records ", declared, " (at byte ", file.offset(), ")"));
+  }
   return mesh;
 }
 

@@ -405,6 +405,33 @@ bool has_control_character(const std::string& text) {
 // components nested ten deep hang it. The model parts are scanned here first (streamed through
 // libzip) and the build's number of object instances bounded before lib3mf sees the file.
 constexpr double kMaxInstances = 1e6;
+// lib3mf 1.8 reads a model part through 32-bit sizes: a larger part (a zip bomb) ends in unrelated
+// errors ("No build section").
+constexpr uint64_t kMaxModelPartBytes = (uint64_t{1} << 31) - 1;
+
+// Whether `text` is a number as 3MF writes them (XML Schema ST_Number: [+-]digits[.digits][e[+-]digits]);
+// lib3mf reads "abc" as 0 and "10abc" as 10.
+bool is_xml_number(const std::string& text) {
+  size_t i = 0, n = text.size();
+  auto digits = [&] {
+    const size_t start = i;
+    while (i < n && text[i] >= '0' && text[i] <= '9') ++i;
+    return i - start;
+  };
+  if (i < n && (text[i] == '+' || text[i] == '-')) ++i;
+  size_t mantissa = digits();
+  if (i < n && text[i] == '.') {
+    ++i;
+    mantissa += digits();
+  }
+  if (mantissa == 0) return false;
+  if (i < n && (text[i] == 'e' || text[i] == 'E')) {
+    ++i;
+    if (i < n && (text[i] == '+' || text[i] == '-')) ++i;
+    if (digits() == 0) return false;
+  }
+  return i == n;
+}
 
 void precheck_components(const std::string& path) {
   int error = 0;
@@ -417,20 +444,39 @@ void precheck_components(const std::string& path) {
     const char* name = zip_get_name(archive.get(), zip_uint64_t(e), 0);
     std::string entry = name ? name : "";
     if (entry.size() < 6 || entry.compare(entry.size() - 6, 6, ".model") != 0) continue;
+    zip_stat_t stat;
+    zip_stat_init(&stat);
+    if (zip_stat_index(archive.get(), zip_uint64_t(e), 0, &stat) == 0 && (stat.valid & ZIP_STAT_SIZE) &&
+        stat.size > kMaxModelPartBytes)
+      throw ResourceLimit(cat(path, ": the model part ", entry, " unpacks to ", uint64_t(stat.size),
+                              " bytes, more than the 2 GB a model part may have"));
+    uint64_t unpacked = 0, vertex = 0;
     std::unique_ptr<zip_file_t, int (*)(zip_file_t*)> file(zip_fopen_index(archive.get(), zip_uint64_t(e), 0),
                                                            zip_fclose);
     if (!file) continue;
     std::string tag, current_object;
     bool in_tag = false;
     char buffer[1 << 16];
+    // The value of attribute `key` (either quote, spaces around '=' allowed); empty when absent.
     auto attribute = [](const std::string& t, const char* key) {
-      std::string pattern = std::string(" ") + key + "=\"";
-      size_t at = t.find(pattern);
-      if (at == std::string::npos) return std::string();
-      size_t begin = at + pattern.size(), end = t.find('"', begin);
-      return end == std::string::npos ? std::string() : t.substr(begin, end - begin);
+      const std::string spaced = std::string(" ") + key;
+      for (size_t at = t.find(spaced); at != std::string::npos; at = t.find(spaced, at + 1)) {
+        size_t i = at + spaced.size();
+        while (i < t.size() && t[i] == ' ') ++i;
+        if (i >= t.size() || t[i] != '=') continue;
+        ++i;
+        while (i < t.size() && t[i] == ' ') ++i;
+        if (i >= t.size() || (t[i] != '"' && t[i] != '\'')) continue;
+        const size_t end = t.find(t[i], i + 1);
+        return end == std::string::npos ? std::string() : t.substr(i + 1, end - i - 1);
+      }
+      return std::string();
     };
     for (zip_int64_t got; (got = zip_fread(file.get(), buffer, sizeof buffer)) > 0;) {
+      // The directory's sizes can lie; what comes out is counted.
+      unpacked += uint64_t(got);
+      if (unpacked > kMaxModelPartBytes)
+        throw ResourceLimit(cat(path, ": the model part ", entry, " unpacks to more than the 2 GB a model part may have"));
       for (zip_int64_t i = 0; i < got; ++i) {
         char c = buffer[i];
         if (!in_tag) {
@@ -445,7 +491,17 @@ void precheck_components(const std::string& path) {
           continue;
         }
         in_tag = false;
-        if (tag.rfind("object ", 0) == 0) {
+        if (tag.rfind("vertex ", 0) == 0) {
+          for (const char* axis : {"x", "y", "z"}) {
+            const std::string value = attribute(tag, axis);
+            if (!is_xml_number(value))
+              throw InvalidInput(cat(path, ": ", entry, ": vertex ", vertex, ": coordinate ", axis, "=\"",
+                                     value.substr(0, 40), "\" is not a number"));
+          }
+          ++vertex;
+        } else if (tag.rfind("!DOCTYPE", 0) == 0 || tag.rfind("!ENTITY", 0) == 0) {
+          throw InvalidInput(cat(path, ": ", entry, ": holds a document type declaration (<!DOCTYPE>), which 3MF does not allow"));
+        } else if (tag.rfind("object ", 0) == 0) {
           current_object = attribute(tag, "id");
           children[current_object];
         } else if (tag.rfind("/object", 0) == 0) {

@@ -58,8 +58,13 @@ PrintabilityReport analyze_printability(const Volume& part, const PrintabilityOp
   const double h = part.voxel_size_mm();
   if (options.min_wall_mm > 0) {
     const double r = 0.5 * options.min_wall_mm;
-    Volume opened = offset(offset(part, -r), r);
-    report.thin_walls = features(subtract(part, opened), r, &report.thin_wall_surface);
+    // Eroding by half the smallest side of the part's box or more leaves nothing: the whole part is
+    // thinner than the wall asked for (and offsetting by such a distance would only cost memory).
+    const Vec3d size = part.bounding_box().size();
+    const double half_side = 0.5 * std::min({size.x, size.y, size.z});
+    const bool all_thin = r >= half_side;
+    Volume opened = all_thin ? Volume() : offset(offset(part, -r), r);
+    report.thin_walls = features(subtract(part, opened), std::min(r, half_side), &report.thin_wall_surface);
   }
   if (options.min_hole_mm > 0) {
     const double r = 0.5 * options.min_hole_mm;

@@ -1,10 +1,12 @@
 #include "solids/region.h"
 
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
+#include <CGAL/Constrained_triangulation_plus_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Triangulation_face_base_with_info_2.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
 
+#include <algorithm>
 #include <cmath>
 #include <list>
 #include <string>
@@ -24,8 +26,18 @@ using FaceBaseInfo = CGAL::Triangulation_face_base_with_info_2<FaceInfo, Kernel>
 using FaceBase = CGAL::Constrained_triangulation_face_base_2<Kernel, FaceBaseInfo>;
 using Tds = CGAL::Triangulation_data_structure_2<VertexBase, FaceBase>;
 // Crossing loops would need new intersection points; refuse them instead of guessing.
-using Cdt = CGAL::Constrained_Delaunay_triangulation_2<Kernel, Tds,
-                                                       CGAL::No_constraint_intersection_requiring_constructions_tag>;
+using CdtBase = CGAL::Constrained_Delaunay_triangulation_2<Kernel, Tds,
+                                                           CGAL::No_constraint_intersection_requiring_constructions_tag>;
+// The "plus" hierarchy counts how many loops run along each constrained edge, for the even-odd rule.
+using Cdt = CGAL::Constrained_triangulation_plus_2<CdtBase>;
+
+// Whether the constrained edge separates material from void: an edge that an even number of loop
+// edges run along (two identical loops, a loop doubling back) is no border under the even-odd rule.
+bool is_border(const Cdt& cdt, const Cdt::Edge& e) {
+  if (!cdt.is_constrained(e)) return false;
+  const auto va = e.first->vertex(Cdt::cw(e.second)), vb = e.first->vertex(Cdt::ccw(e.second));
+  return cdt.number_of_enclosing_constraints(va, vb) % 2 == 1;
+}
 
 // Nesting level of every face: 0 outside, odd inside the material (even-odd rule), as in CGAL's
 // polygon-with-holes example.
@@ -44,7 +56,7 @@ void mark_domains(Cdt& cdt) {
         Cdt::Edge e(fh, i);
         Cdt::Face_handle n = fh->neighbor(i);
         if (n->info().nesting_level == -1) {
-          if (cdt.is_constrained(e)) border.push_back(e);
+          if (is_border(cdt, e)) border.push_back(e);
           else queue.push_back(n);
         }
       }
@@ -72,11 +84,20 @@ Cdt triangulate(const Region2& region) {
           throw InvalidInput("region loop " + std::to_string(l) + ": has a non-finite point");
         points.emplace_back(p.x, p.y);
       }
+      // A loop on one line (or of one repeated point) encloses nothing, and leaves the triangulation
+      // without faces when it is the only one.
+      const auto second = std::find_if(points.begin(), points.end(), [&](const Kernel::Point_2& p) { return p != points.front(); });
+      const bool flat = second == points.end() || std::none_of(points.begin(), points.end(), [&](const Kernel::Point_2& q) {
+                          return CGAL::orientation(points.front(), *second, q) != CGAL::COLLINEAR;
+                        });
+      if (flat)
+        throw InvalidInput("region loop " + std::to_string(l) + ": its points lie on one line (or repeat one point); a loop must enclose an area");
       cdt.insert_constraint(points.begin(), points.end(), /*close=*/true);
     }
   } catch (const Cdt::Intersection_of_constraints_exception&) {
     throw InvalidInput("region: loops cross each other or themselves");
   }
+  if (cdt.dimension() < 2) throw InvalidInput("region: the loops enclose no area");
   mark_domains(cdt);
   return cdt;
 }

@@ -1,7 +1,10 @@
 #include "solids/tetrahedralize.h"
 
 #include <poll.h>
+#include <pthread.h>
 #include <signal.h>
+#include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <tetgen.h>
 #include <unistd.h>
@@ -58,6 +61,33 @@ bool write_all(int fd, const void* data, size_t size) {
     size -= size_t(n);
   }
   return true;
+}
+
+// The address space the process maps now (bytes), from /proc/self/statm; 0 where unknown.
+uint64_t mapped_bytes() {
+  std::FILE* file = std::fopen("/proc/self/statm", "r");
+  if (!file) return 0;
+  unsigned long long pages = 0;
+  const bool read = std::fscanf(file, "%llu", &pages) == 1;
+  std::fclose(file);
+  return read ? uint64_t(pages) * uint64_t(::sysconf(_SC_PAGESIZE)) : 0;
+}
+
+// What the child does first: die with its parent (also if the parent is gone already), take the
+// default action for the signals a front end may have blocked or caught, and stay within
+// `address_limit` bytes of address space (0: no limit), so that TetGen's allocations fail cleanly.
+void prepare_child(pid_t parent, uint64_t address_limit) {
+  ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+  if (::getppid() != parent) ::_exit(5);
+  ::signal(SIGINT, SIG_DFL);
+  ::signal(SIGTERM, SIG_DFL);
+  sigset_t none;
+  sigemptyset(&none);
+  ::pthread_sigmask(SIG_SETMASK, &none, nullptr);
+  if (address_limit) {
+    rlimit limit{rlim_t(address_limit), rlim_t(address_limit)};
+    ::setrlimit(RLIMIT_AS, &limit);
+  }
 }
 
 [[noreturn]] void run_child(int fd, const TriMesh& surface, const std::vector<Vec3d>& holes,
@@ -183,6 +213,9 @@ TetMesh tetrahedralize(const TriMesh& surface, const TetOptions& options, const 
   int fds[2];
   if (::pipe(fds) != 0) throw std::runtime_error("cannot create a pipe for TetGen");
   std::fflush(nullptr);
+  const pid_t parent = ::getpid();
+  // The child starts with the parent's address space mapped; it may add the budget to it.
+  const uint64_t address_limit = options.max_memory_bytes ? mapped_bytes() + options.max_memory_bytes : 0;
   pid_t pid = ::fork();
   if (pid < 0) {
     ::close(fds[0]);
@@ -191,6 +224,7 @@ TetMesh tetrahedralize(const TriMesh& surface, const TetOptions& options, const 
   }
   if (pid == 0) {
     ::close(fds[0]);
+    prepare_child(parent, address_limit);
     run_child(fds[1], surface, holes, region_seeds, switches);
   }
   ::close(fds[1]);
@@ -224,7 +258,11 @@ TetMesh tetrahedralize(const TriMesh& surface, const TetOptions& options, const 
   if (data.size() < sizeof(Header)) throw InvalidInput("TetGen stopped without a result");
   Header header;
   std::memcpy(&header, data.data(), sizeof header);
-  if (header.status == 1) throw ResourceLimit(tetgen_error(1));
+  if (header.status == 1)
+    throw ResourceLimit(options.max_memory_bytes
+                            ? "TetGen ran out of its memory budget of " + number(double(options.max_memory_bytes) / 1e9) +
+                                  " GB (--max-memory); relax the volume or quality bound"
+                            : tetgen_error(1));
   if (header.status != 0) throw InvalidInput(tetgen_error(header.status) + " (switches " + switches + ")");
   const size_t expected = sizeof(Header) + sizeof(REAL) * 3 * header.points + sizeof(int) * 4 * header.tets +
                           (header.has_attributes ? sizeof(REAL) * header.tets : 0);

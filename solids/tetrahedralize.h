@@ -17,6 +17,7 @@ struct TetOptions {
                                      // the surface's triangles; only without bounds: TetGen 1.5 refines
                                      // nothing under -Y (with bounds, added points still lie on the surface)
   double time_limit_s = 600;         // TetGen runs in a child process, stopped after this long
+  uint64_t max_memory_bytes = 0;     // the child may allocate this much (RLIMIT_AS); 0: no limit of its own
 };
 
 // The TetGen switch string for the options: always a piecewise linear complex, zero-based,
@@ -29,7 +30,7 @@ std::string tetgen_switches(const TetOptions& options, bool regions);
 // nested inside an odd number of others) stay empty. `region_seeds` (optional) gives a point per
 // material region; tetrahedra get the index of their region's seed. Throws InvalidInput when
 // TetGen rejects the surface (self-intersections, features too small), ResourceLimit when it runs
-// out of memory or time.
+// out of memory (its budget) or time. The child process dies with the one that started it.
 TetMesh tetrahedralize(const TriMesh& surface, const TetOptions& options,
                        const std::vector<Vec3d>& region_seeds = {});
 

@@ -30,8 +30,8 @@ openvdb::math::Transform::Ptr make_transform(double voxel_size_mm) {
 
 openvdb::FloatGrid::Ptr make_level_set_grid(const VolumeOptions& options) {
   ensure_openvdb_initialized();
-  if (!(options.voxel_size_mm > 0) || !std::isfinite(options.voxel_size_mm))
-    throw InvalidInput("voxel size must be a positive length in mm");
+  if (!(options.voxel_size_mm >= kMinVoxelSizeMm && options.voxel_size_mm <= kMaxVoxelSizeMm))
+    throw InvalidInput("voxel size must be from 0.0001 to 1000 mm");
   if (!(options.half_band_voxels >= 2))
     throw InvalidInput("the narrow band must be at least 2 voxels wide on each side");
   auto grid = openvdb::FloatGrid::create(static_cast<float>(options.voxel_size_mm * options.half_band_voxels));
@@ -118,7 +118,7 @@ openvdb::FloatGrid::Ptr mesh_distance(const TriMesh& mesh, double h, double outs
 void require_same_grid(const Volume& a, const Volume& b, const char* op) {
   if (a.voxel_size_mm() != b.voxel_size_mm() || a.band_mm() != b.band_mm())
     throw InvalidInput(std::string(op) + ": volumes have different voxel sizes (" +
-                       std::to_string(a.voxel_size_mm()) + " mm and " + std::to_string(b.voxel_size_mm()) +
+                       message_number(a.voxel_size_mm()) + " mm and " + message_number(b.voxel_size_mm()) +
                        " mm); build both with the same voxel size");
 }
 

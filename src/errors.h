@@ -3,10 +3,18 @@
 // report), never an exception.
 #pragma once
 
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
 namespace lacuna {
+
+// A number for messages: six significant digits ("1.79769e+308", not std::to_string's 309 digits).
+inline std::string message_number(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", value);
+  return text;
+}
 
 // Every error the library throws on purpose; what() is a message a user can act on.
 class Error : public std::runtime_error {

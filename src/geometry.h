@@ -11,6 +11,11 @@
 
 namespace lacuna {
 
+// The voxel sizes Lacuna works with (mm): below, OpenVDB's transforms lose their scale (a voxel's
+// volume nears double's epsilon) and no printer resolves it; above, no part is resolved at all.
+constexpr double kMinVoxelSizeMm = 1e-4;
+constexpr double kMaxVoxelSizeMm = 1000;
+
 struct Vec3d {
   double x = 0, y = 0, z = 0;
 

@@ -190,7 +190,7 @@ struct Canvas {
 void validate(const GeometryOptions& options) {
   auto check = [](double value, const char* name) {
     if (!(value > 0 && value < 1))
-      throw InvalidInput(std::string("geometry option ") + name + " must be in (0, 1), got " + std::to_string(value));
+      throw InvalidInput(std::string("geometry option ") + name + " must be in (0, 1), got " + message_number(value));
   };
   check(options.gap_fraction, "gap_fraction");
   check(options.lacuna_scale, "lacuna_scale");

@@ -121,7 +121,7 @@ void validate(const Automaton& a) {
       for (Eigen::Index c = 0; c < tr.matrix.cols(); ++c)
         if (std::fabs(tr.matrix.col(c).sum() - 1.0) > kSumTolerance)
           throw InvalidInput(here + ": column " + std::to_string(c) + " sums to " +
-                             std::to_string(tr.matrix.col(c).sum()) + ", expected 1 (barycentric)");
+                             message_number(tr.matrix.col(c).sum()) + ", expected 1 (barycentric)");
     }
   }
 }

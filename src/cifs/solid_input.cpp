@@ -12,7 +12,9 @@ namespace lacuna {
 namespace cifs {
 namespace {
 
-constexpr uint64_t kMaxPieces = 500'000'000;
+// Every piece is streamed through the rasterizer (about 25 us each with its edges): 20 million take
+// minutes; more would run for hours with nothing to show.
+constexpr uint64_t kMaxPieces = 20'000'000;
 
 Vec3d column(const Eigen::Matrix3Xd& v, Eigen::Index i) { return Vec3d{v(0, i), v(1, i), v(2, i)}; }
 

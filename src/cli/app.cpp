@@ -5,6 +5,10 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <csignal>
+#include <cstdlib>
+#include <cstring>
+#include <thread>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -17,10 +21,12 @@
 #include "cli/curve_commands.h"
 #include "cli/exit_codes.h"
 #include "cli/fill_commands.h"
+#include "cli/number_checks.h"
 #include "cli/terminal_progress.h"
 #include "cli/voronoi_commands.h"
 #include "errors.h"
 #include "export/fea.h"
+#include "export/output_files.h"
 #include "export/report.h"
 #include "pipeline/pipeline.h"
 #include "util/progress.h"
@@ -92,8 +98,9 @@ Vec3d parse_direction(const std::string& text) {
   throw InvalidInput("--build-dir: expected x, y, z, -x, -y, -z or \"dx,dy,dz\", got \"" + text + "\"");
 }
 
-int command_check(const std::string& path, const CommonFlags& flags, const PrintArgs& print) {
+int command_check(const std::string& path, const CommonFlags& flags, const PrintArgs& print, uint64_t max_memory_bytes) {
   CheckFileOptions options;
+  options.max_memory_bytes = max_memory_bytes;
   options.printability = print.enabled;
   options.min_wall_mm = print.min_wall;
   options.min_hole_mm = print.min_hole;
@@ -171,6 +178,7 @@ int command_fea(const FeaArgs& args, const RunOptions& base, const CommonFlags& 
     }
     report = first;
   } else {
+    out.fea.max_memory_bytes = base.max_memory_bytes;
     const TetCheck check = write_tetrahedra(args.input, path, out.fea, std::max(0.0, args.simplify));
     report = fea_report_json(check);
     report["file"] = path;
@@ -189,9 +197,37 @@ int command_fea(const FeaArgs& args, const RunOptions& base, const CommonFlags& 
   return kExitOk;
 }
 
+// SIGINT and SIGTERM end the program after the files of unfinished outputs are removed: both are
+// blocked in every thread (threads started later inherit the mask), and one thread waits for them,
+// cleans up outside any signal handler, and ends the process by the signal's default action.
+void handle_interruptions() {
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  if (pthread_sigmask(SIG_BLOCK, &signals, nullptr) != 0) return;
+  std::thread([signals] {
+    int signal = 0;
+    if (sigwait(&signals, &signal) != 0) return;
+    remove_unfinished_outputs();
+    const char* message = signal == SIGINT ? "lacuna: interrupted; unfinished outputs removed\n"
+                                           : "lacuna: terminated; unfinished outputs removed\n";
+    if (::write(STDERR_FILENO, message, std::strlen(message)) < 0) {
+    }
+    std::signal(signal, SIG_DFL);
+    sigset_t one;
+    sigemptyset(&one);
+    sigaddset(&one, signal);
+    pthread_sigmask(SIG_UNBLOCK, &one, nullptr);
+    std::raise(signal);
+    std::_Exit(128 + signal);
+  }).detach();
+}
+
 }  // namespace
 
 int run_app(int argc, char** argv) {
+  handle_interruptions();
   CLI::App app{"Lacuna: volumetric solid modeling for additive manufacturing.\n"
                "Runs recipe files (JSON) into checked, printable STL and 3MF parts.\n"
                "Exit codes: 0 success, 2 bad usage or input, 3 resource limit, 4 failed validity check."};
@@ -206,13 +242,13 @@ int run_app(int argc, char** argv) {
   run_command->add_option("RECIPE", recipe, "Recipe file (JSON)")->required();
   run_command->add_option("-o,--output", run_options.output_dir, "Folder for the outputs (default: <recipe name>-out)");
   run_command->add_option("--voxel-size", run_options.voxel_size_mm, "Voxel size in mm, overriding the recipe's")
-      ->check(CLI::PositiveNumber);
+      ->check(number_in(kMinVoxelSizeMm, kMaxVoxelSizeMm));
   run_command->add_option("--simplify", run_options.simplify_mm,
                           "Deviation in mm of the compact meshes written, overriding the recipe's (0: the plain "
                           "marching-tetrahedra surface; default: a fifth of the voxel)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_number());
   run_command->add_option("--max-memory", max_memory_gb, "Memory budget in GB (default: half of the machine's memory)")
-      ->check(CLI::PositiveNumber);
+      ->check(number_in(0, 1e9, true));
   add_common(run_command, flags);
 
   std::string mesh_path;
@@ -222,13 +258,15 @@ int run_app(int argc, char** argv) {
   check->add_option("MESH", mesh_path, "Mesh file")->required();
   PrintArgs print;
   check->add_flag("--print", print.enabled, "Also analyse printability: trapped voids, thin walls, small holes, overhang");
-  check->add_option("--min-wall", print.min_wall, "With --print: thinnest wall allowed, mm")->check(CLI::NonNegativeNumber);
-  check->add_option("--min-hole", print.min_hole, "With --print: narrowest hole or channel allowed, mm")->check(CLI::NonNegativeNumber);
+  check->add_option("--min-wall", print.min_wall, "With --print: thinnest wall allowed, mm")->check(non_negative_number());
+  check->add_option("--min-hole", print.min_hole, "With --print: narrowest hole or channel allowed, mm")->check(non_negative_number());
   check->add_option("--build-dir", print.build_dir, "With --print: build direction, x y z -x -y -z or dx,dy,dz (default z)");
   check->add_option("--critical-angle", print.critical_angle, "With --print: down-facing surface flatter than this is overhang, degrees (45)")
-      ->check(CLI::Range(0.0, 90.0));
+      ->check(number_in(0, 90));
   check->add_option("--voxel-size", print.voxel, "With --print: voxel size of the analysis, mm (default: a quarter of the smallest size)")
-      ->check(CLI::PositiveNumber);
+      ->check(number_in(kMinVoxelSizeMm, kMaxVoxelSizeMm));
+  check->add_option("--max-memory", max_memory_gb, "With --print: memory budget in GB (default: half of the machine's memory)")
+      ->check(number_in(0, 1e9, true));
   add_common(check, flags);
   FeaArgs fea_args;
   CLI::App* fea = app.add_subcommand(
@@ -239,18 +277,22 @@ int run_app(int argc, char** argv) {
   fea->add_option("--format", fea_args.format, "inp, msh, vtu or mesh (must match the output's extension)")
       ->check(CLI::IsMember({"inp", "msh", "vtu", "mesh"}));
   fea->add_option("--max-tet-volume", fea_args.max_tet_volume, "Largest tetrahedron in mm3 (default: unbounded)")
-      ->check(CLI::PositiveNumber);
-  fea->add_option("--quality", fea_args.quality, "Radius-edge ratio bound, > 1 (e.g. 1.4; default: none)");
-  fea->add_option("--min-dihedral", fea_args.min_dihedral, "Smallest dihedral angle to aim for, degrees (with --quality)");
+      ->check(positive_number());
+  fea->add_option("--quality", fea_args.quality, "Radius-edge ratio bound, > 1 (e.g. 1.4; default: none)")
+      ->check(finite_number());
+  fea->add_option("--min-dihedral", fea_args.min_dihedral, "Smallest dihedral angle to aim for, degrees (with --quality)")
+      ->check(finite_number());
   fea->add_option("--simplify,--decimate", fea_args.simplify,
                   "Simplify the surface to this deviation in mm first, every collapse guarded (0: not at all; default: "
                   "a recipe's own, none for a mesh file)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_number());
+  fea->add_option("--max-memory", max_memory_gb, "Memory budget in GB, TetGen's included (default: half of the machine's memory)")
+      ->check(number_in(0, 1e9, true));
   fea->add_flag("--msh2", fea_args.msh2, "Gmsh format 2.2 instead of 4.1");
   fea->add_flag("--c3d10", fea_args.c3d10, "Quadratic C3D10 elements in .inp (mid-side nodes)");
   fea->add_flag("--free-surface", fea_args.free_surface, "Let TetGen add points on the surface (no -Y)");
   fea->add_option("--voxel-size", run_options.voxel_size_mm, "Voxel size in mm for a recipe, overriding its own")
-      ->check(CLI::PositiveNumber);
+      ->check(number_in(kMinVoxelSizeMm, kMaxVoxelSizeMm));
   add_common(fea, flags);
   std::function<int()> cifs_command = add_cifs_commands(app);
   std::function<int()> curve_command = add_curve_commands(app);
@@ -274,11 +316,9 @@ int run_app(int argc, char** argv) {
   run_options.threads = flags.threads;
   run_options.progress = current_progress_sink();
   try {
-    if (*run_command) {
-      run_options.max_memory_bytes = uint64_t(max_memory_gb * 1e9);
-      return command_run(recipe, run_options, flags);
-    }
-    if (*check) return command_check(mesh_path, flags, print);
+    run_options.max_memory_bytes = uint64_t(max_memory_gb * 1e9);
+    if (*run_command) return command_run(recipe, run_options, flags);
+    if (*check) return command_check(mesh_path, flags, print, run_options.max_memory_bytes);
     if (*fea) return command_fea(fea_args, run_options, flags);
     for (const auto& command : {cifs_command, curve_command, fill_command, voronoi_command, bcifs_command}) {
       const int code = command();
@@ -292,7 +332,9 @@ int run_app(int argc, char** argv) {
     std::cerr << "lacuna: error: " << e.what() << "\n";
     return exit_code(e);
   } catch (const std::bad_alloc& e) {
-    std::cerr << "lacuna: error: out of memory; use a larger voxel size or a lower --max-memory estimate\n";
+    // The estimates made before allocating missed this one, so the cause is not known here.
+    std::cerr << "lacuna: error: out of memory: the machine could not give this job what it asked for; use coarser "
+                 "settings (voxel size, tolerances, levels, counts) or a smaller input\n";
     return exit_code(e);
   } catch (const std::exception& e) {
     std::cerr << "lacuna: internal error: " << e.what() << "\n";

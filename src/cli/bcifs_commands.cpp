@@ -89,11 +89,7 @@ std::vector<uint8_t> flip_rows(const std::vector<uint8_t>& rgb, int width, int h
 
 int bcifs_measure(const BcifsArgs& a) {
   const auto [lo, hi] = parse_levels(a.levels);
-  std::ifstream file(a.recipe, std::ios::binary);
-  if (!file) throw IoError(a.recipe + ": cannot open the recipe file");
-  std::stringstream text;
-  text << file.rdbuf();
-  const nlohmann::json top = parse_json_text(text.str(), a.recipe);
+  const nlohmann::json top = read_json_file(a.recipe, "a recipe file (.json)");
   if (!top.is_object() || !top.contains("inputs") || !top["inputs"].is_object())
     throw InvalidInput(a.recipe + ": expected a recipe with \"inputs\"");
   const fs::path out_dir = a.out_dir.empty() ? fs::path(fs::path(a.recipe).stem().string() + "_measures") : fs::path(a.out_dir);

@@ -1,5 +1,6 @@
 #include "cli/cifs_commands.h"
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -41,6 +42,7 @@ std::vector<double> parse_knots(const std::string& text) {
       size_t used = 0;
       double v = std::stod(item, &used);
       if (used != item.size() && item.find_first_not_of(" ", used) != std::string::npos) throw std::invalid_argument(item);
+      if (!std::isfinite(v)) throw std::invalid_argument(item);
       knots.push_back(v);
     } catch (const std::exception&) {
       throw InvalidInput("--knots: \"" + item + "\" is not a number (expected t0,t1,...)");
@@ -148,11 +150,7 @@ int nurbs_automaton_command(const NurbsArgs& args) {
 
 int nurbs_tessellate_command(const NurbsArgs& args) {
   std::vector<double> knots = parse_knots(args.knots);
-  std::ifstream in(args.control_points, std::ios::binary);
-  if (!in) throw IoError(args.control_points + ": cannot open the control points file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  const nlohmann::json points = parse_json_text(text.str(), args.control_points);
+  const nlohmann::json points = read_json_file(args.control_points, "a control points file (.json)");
   const NurbsCurvePoints curve = nurbs_curve_points(args.degree, knots, points, args.level, args.control_points);
   nlohmann::json out = {{"degree", args.degree}, {"level", args.level}, {"points", nlohmann::json::array()},
                         {"parameters", curve.parameters}};

@@ -9,6 +9,7 @@
 #include "curves/curves.h"
 #include "curves/sweep.h"
 #include "cli/exit_codes.h"
+#include "cli/number_checks.h"
 #include "errors.h"
 #include "pipeline/generators.h"
 
@@ -117,9 +118,9 @@ std::function<int()> add_curve_commands(CLI::App& app) {
   }
   points->add_option("--surface", args->surface, "plane, sphere, cylinder, torus, cone or cube");
   points->add_option("--tolerance", args->tolerance, "Chord tolerance on a surface (units of the square)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   points->add_flag("--csv", args->csv, "Print order,polyline,x,y,z lines");
-  fill->add_option("--width", args->width, "Stroke width (the square has side 2)")->check(CLI::PositiveNumber);
+  fill->add_option("--width", args->width, "Stroke width (the square has side 2)")->check(positive_number());
   return [=]() -> int {
     if (*points) return curve_points(*args);
     if (*fill) return curve_fill_rate(*args);

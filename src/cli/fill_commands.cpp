@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "cli/exit_codes.h"
+#include "cli/number_checks.h"
 #include "errors.h"
 #include "fill/fill.h"
 #include "fill/wallpaper.h"
@@ -169,12 +170,14 @@ std::function<int()> add_fill_commands(CLI::App& app) {
   CLI::App* pattern = fill->add_subcommand("pattern", "Fill a wallpaper group's fundamental region by the area rule");
   pattern->add_option("--group", args->group, "One of the 17 wallpaper groups: p1 p2 pm pg cm pmm pmg pgg cmm p4 p4m p4g p3 p3m1 p31m p6 p6m");
   pattern->add_option("--lattice", args->lattice, "Lattice vectors \"ax,ay;bx,by\" in mm (default 10,0;0,10)");
-  pattern->add_option("--c", args->c, "Exponent of the area rule, > 1 (dimension 2/c)");
-  pattern->add_option("--N", args->N, "Offset of the area rule, > 1");
+  pattern->add_option("--c", args->c, "Exponent of the area rule, > 1 (dimension 2/c)")->check(finite_number());
+  pattern->add_option("--N", args->N, "Offset of the area rule, > 1")->check(finite_number());
   pattern->add_option("--motif", args->motif, "circle, triangle, square, hexagon or ngon:N");
-  pattern->add_option("--count", args->count, "Most motifs in the fundamental region");
+  pattern->add_option("--count", args->count, "Most motifs in the fundamental region")
+      ->check(CLI::Range(size_t(1), fill::kMaxFillCount));
   pattern->add_option("--max-trials", args->max_trials, "Random positions tried per motif before stopping");
-  pattern->add_option("--gap", args->gap, "Least distance between motifs, images included (mm)");
+  pattern->add_option("--gap", args->gap, "Least distance between motifs, images included (mm)")
+      ->check(non_negative_number());
   pattern->add_option("--seed", args->seed, "Seed of the generator");
   pattern->add_option("--policy", args->policy, "Motifs meeting a mirror or rotation centre: allow, reject or snap");
   pattern->add_flag("--random-rotation", args->random_rotation, "Turn every motif by a random angle");

@@ -558,7 +558,6 @@ Polyline3 map_polyline(const Polyline2& polyline, const SurfaceMap& map, const M
     if (o.offset_mm != 0) p += surface_normal(map, q.x, q.y) * o.offset_mm;
     return p;
   };
-  constexpr size_t kMaxPoints = 50000000;
   Polyline3 out;
   out.closed = polyline.closed;
   // Appends the points strictly inside segment a-b (images pa, pb), in order.
@@ -569,9 +568,9 @@ Polyline3 map_polyline(const Polyline2& polyline, const SurfaceMap& map, const M
         const Vec3d pm = place(m);
         if (norm((pa + pb) * 0.5 - pm) <= o.tolerance_mm) return;
         split(a, pa, m, pm, depth + 1);
-        if (out.points.size() >= kMaxPoints)
-          throw ResourceLimit("mapping onto '" + map.name +
-                              "' would make more than 50 000 000 points; raise the tolerance");
+        if (out.points.size() >= o.max_points)
+          throw ResourceLimit("mapping onto '" + map.name + "' would make more than " + std::to_string(o.max_points) +
+                              " points (the memory budget's share); raise tolerance_mm");
         out.points.push_back(pm);
         split(m, pm, b, pb, depth + 1);
       };

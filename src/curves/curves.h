@@ -139,13 +139,15 @@ struct MapOptions {
   double offset_mm = 0;        // along the unit normal after scaling, positive outwards
   double tolerance_mm = 0.01;  // largest distance from a chord's midpoint to the image of its square midpoint
   int max_depth = 20;          // most halvings of one segment of the square
+  uint64_t max_points = 50'000'000;  // most points of one mapped polyline (a memory bound)
 };
 
 // The image of a polyline of the square on a surface, each segment halved in the square (recursively,
 // at most max_depth times) until the distance between the midpoint of the mapped chord and the mapped
 // square midpoint is at most tolerance_mm. The result has the input's points (mapped) plus the inserted
 // ones, and the same closed flag. Throws InvalidInput for a map without point function, a non-positive
-// scale or tolerance, or max_depth outside 0 .. 40; ResourceLimit past 50 000 000 points.
+// scale or tolerance, or max_depth outside 0 .. 40; ResourceLimit past max_points points (counted as
+// they are made).
 Polyline3 map_polyline(const Polyline2& polyline, const SurfaceMap& map, const MapOptions& options = {});
 
 // The curve of one order drawn on all six faces of the cube [-1, 1]^3 through cube_face_map(), scaled

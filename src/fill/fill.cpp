@@ -288,7 +288,8 @@ bool overlap(const Shape2& a, const Shape2& b, double gap) {
   return gap > 0 && vertex_outline_distance(a.points, b.points) < gap;
 }
 
-void check_law(double c, double N, double gap, double boundary_gap, size_t trials) {
+void check_law(double c, double N, double gap, double boundary_gap, size_t trials, size_t count) {
+  if (count > kMaxFillCount) throw InvalidInput("fill: count must be at most 10 000 000, got " + std::to_string(count));
   if (!(std::isfinite(c) && c > 1)) throw InvalidInput("fill: the exponent c must be > 1, got " + number(c));
   if (!(std::isfinite(N) && N > 1)) throw InvalidInput("fill: the offset N must be > 1, got " + number(N));
   if (!(std::isfinite(gap) && gap >= 0)) throw InvalidInput("fill: gap_mm must be >= 0, got " + number(gap));
@@ -471,7 +472,7 @@ bool contains(const FillRegion2& region, const Motif2& motif, const Placement2& 
 }
 
 FillResult2 fill_region(const FillRegion2& region, const Motif2& motif, const FillOptions& options) {
-  detail::check_law(options.c, options.N, options.gap_mm, options.boundary_gap_mm, options.max_trials);
+  detail::check_law(options.c, options.N, options.gap_mm, options.boundary_gap_mm, options.max_trials, options.max_count);
   const double A = area(region);
   Vec2d lo, hi;
   region_box(region, lo, hi);
@@ -504,7 +505,7 @@ FillResult2 fill_region(const FillRegion2& region, const Motif2& motif, const Fi
 
 FillResult3 fill_spheres(const SignedDistance3& signed_distance_mm, const Box3& box, double volume_mm3,
                          const FillOptions3& options) {
-  detail::check_law(options.c, options.N, options.gap_mm, options.boundary_gap_mm, options.max_trials);
+  detail::check_law(options.c, options.N, options.gap_mm, options.boundary_gap_mm, options.max_trials, options.max_count);
   if (!signed_distance_mm) throw InvalidInput("fill_spheres needs a signed distance function");
   if (box.empty() || !is_finite(box.min) || !is_finite(box.max)) throw InvalidInput("fill_spheres needs a finite, non-empty box");
   if (!(std::isfinite(volume_mm3) && volume_mm3 > 0))

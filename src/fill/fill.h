@@ -79,6 +79,9 @@ double area(const FillRegion2& region);  // mm^2
 // Whether the placed motif lies inside the region with every point at least clearance_mm from its boundary.
 bool contains(const FillRegion2& region, const Motif2& motif, const Placement2& placement, double clearance_mm);
 
+// The most motifs (or spheres) one fill places; recipes and the command line refuse more.
+constexpr size_t kMaxFillCount = 10'000'000;
+
 struct FillOptions {
   double c = 1.3;              // exponent of the area law, > 1; the fractal dimension is 2 / c
   double N = 2;                // offset of the area law, > 1

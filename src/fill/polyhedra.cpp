@@ -229,7 +229,7 @@ bool polyhedra_overlap(const Motif3& a, const Placement3& pa, const Motif3& b, c
 
 FillResult3P fill_polyhedra(const SignedDistance3& signed_distance_mm, const Box3& box, double volume_mm3,
                             const Motif3& motif, const FillOptions3& options, bool random_rotation) {
-  detail::check_law(options.c, options.N, options.gap_mm, options.boundary_gap_mm, options.max_trials);
+  detail::check_law(options.c, options.N, options.gap_mm, options.boundary_gap_mm, options.max_trials, options.max_count);
   if (!signed_distance_mm) throw InvalidInput("fill_polyhedra needs a signed distance function");
   if (box.empty() || !is_finite(box.min) || !is_finite(box.max))
     throw InvalidInput("fill_polyhedra needs a finite, non-empty box");

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "errors.h"
 #include "fill/fill.h"
 #include "geometry.h"
 
@@ -53,7 +54,7 @@ bool overlap(const Shape2& a, const Shape2& b, double gap_mm);
 std::string trials_reason(const char* what, size_t i, size_t trials);
 
 // Throws InvalidInput unless c > 1, N > 1, both gaps >= 0 and trials >= 1.
-void check_law(double c, double N, double gap, double boundary_gap, size_t trials);
+void check_law(double c, double N, double gap, double boundary_gap, size_t trials, size_t count);
 
 // The area (volume) rule, shared by every fill: motif i takes the fraction 1 / (zeta(c, N) (N + i)^c) of
 // `measure`. For i = 0 .. max_count - 1 it stops with `min_reason` once that part is below `min_part`;
@@ -63,6 +64,8 @@ void check_law(double c, double N, double gap, double boundary_gap, size_t trial
 template <class Trial>
 double place_by_rule(double measure, double c, double N, size_t max_count, double min_part, const char* min_reason,
                      size_t max_trials, const char* what, std::string& stop_reason, Trial&& trial) {
+  if (max_count > kMaxFillCount)
+    throw InvalidInput("fill: count must be at most 10 000 000, got " + std::to_string(max_count));
   const double zeta = hurwitz_zeta(c, N);
   double filled = 0;
   stop_reason = "max_count";

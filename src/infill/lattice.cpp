@@ -103,8 +103,11 @@ TubeSet lattice_tubes(const Box3& box, const LatticeOptions& o, const HullFields
     } else {
       // A conforming lattice keeps a cell outside the box: its nodes move onto the skin.
       const int64_t margin = conforming ? 1 : 0;
-      lo[k] = int64_t(std::floor(box.min[k] / o.period_mm)) - margin;
-      hi[k] = int64_t(std::ceil(box.max[k] / o.period_mm)) + margin;
+      // Counted in double first: a tiny period would overflow the integer cell indices.
+      const double first = std::floor(box.min[k] / o.period_mm), last = std::ceil(box.max[k] / o.period_mm);
+      if (!(last - first < 1e7)) throw InvalidInput("the lattice would have more than 10 000 000 struts; use a larger period");
+      lo[k] = int64_t(first) - margin;
+      hi[k] = int64_t(last) + margin;
     }
     cells *= double(hi[k] - lo[k]);
   }
@@ -186,6 +189,13 @@ TubeSet lattice_tubes(const Box3& box, const LatticeOptions& o, const HullFields
   for (int64_t i = lo[0]; i < hi[0]; ++i)
     for (int64_t j = lo[1]; j < hi[1]; ++j)
       for (int64_t k = lo[2]; k < hi[2]; ++k) visit(Node{i * fine, j * fine, k * fine}, fine, 0);
+  // An empty lattice would vanish from an infill without a word.
+  if (out.tubes.empty()) {
+    if (conforming)
+      throw InvalidInput("no strut is left: every node lies less than inset_mm (" + message_number(o.conform_inset_mm) +
+                         " mm) deep in the hull or outside it; use a smaller inset_mm or period_mm");
+    throw InvalidInput("the lattice has no strut in its box");
+  }
   return out;
 }
 

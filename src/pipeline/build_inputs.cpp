@@ -264,7 +264,11 @@ class Builder {
       }
     }
     try {
-      curves::Sweep sweep = curves::sweep_curves(c.sweep, map, on_cube);
+      // Points are counted against the budget as they are made (about 128 bytes each, with the tubes
+      // made of them), so that a tiny tolerance_mm is refused before it exhausts the memory.
+      curves::SweepOptions options = c.sweep;
+      options.map.max_points = std::min<uint64_t>(options.map.max_points, context_.max_memory_bytes / 128);
+      curves::Sweep sweep = curves::sweep_curves(options, map, on_cube);
       out_.report = CurveReport{sweep.tubes.tubes.size(), sweep.segments};
       out_.geometry.tubes = std::move(sweep.tubes);
       out_.geometry.surfaces = std::move(sweep.base);

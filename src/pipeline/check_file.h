@@ -17,8 +17,9 @@ struct CheckFileOptions {
   double min_hole_mm = 0;          // 0: not checked
   Vec3d build_direction{0, 0, 1};  // pointing up from the build plate
   double critical_angle_deg = 45;  // down-facing surface flatter than this is overhang
-  double voxel_size_mm = 0;        // of the analysis; 0: a quarter of the smallest size asked about, else the
-                                   // part's diagonal / 300
+  double voxel_size_mm = 0;        // of the analysis; 0: a quarter of the smallest size asked about (at most
+                                   // the part's diagonal / 100), else the part's diagonal / 300
+  uint64_t max_memory_bytes = 0;   // the analysis's budget; 0: half the memory available
 };
 
 struct FileCheck {
@@ -32,7 +33,9 @@ struct FileCheck {
 };
 
 // Reads and checks the mesh file (STL, OBJ, PLY, 3MF). Throws IoError or InvalidInput naming the
-// file when it cannot be read, InvalidInput when printability is asked of a mesh that is not closed.
+// file when it cannot be read, InvalidInput when printability is asked of a mesh that is not closed or
+// with sizes that are not finite lengths (or a voxel size outside 0.0001 to 1000 mm), ResourceLimit
+// (before allocating) when the analysis would not fit the memory budget.
 FileCheck check_file(const std::string& path, const CheckFileOptions& options = {});
 
 // The same for a mesh in memory; `label` stands for the file in the report and in messages.

@@ -93,6 +93,14 @@ Estimate estimate(const Recipe& recipe, const Plan& plan, const BuiltInputs& inp
       const auto* offset = std::get_if<OffsetOperation>(&op);
       const auto* shell = std::get_if<ShellOperation>(&op);
       double d = offset ? std::fabs(offset->distance_mm) : shell ? shell->thickness_mm : std::get<InfillOperation>(op).skin_mm;
+      // Going inwards, nothing is deeper than half the box's smallest side.
+      const Vec3d size = first.box.size();
+      const double half_thickness = 0.5 * std::min({size.x, size.y, size.z});
+      if (offset && offset->distance_mm < 0 && d >= half_thickness)
+        throw InvalidInput(recipe.file + ": " + operation_named(recipe, name).json_path + ": an offset of " +
+                           fixed(offset->distance_mm, 6) + " mm leaves nothing of \"" + of[0] + "\" (it is at most " +
+                           fixed(2 * half_thickness, 6) + " mm thick)");
+      if (!offset || offset->distance_mm < 0) d = std::min(d, half_thickness);
       mesh_of(first.voxels);
       work.half_band_voxels += d / vopt.voxel_size_mm;
       if (offset && offset->distance_mm > 0) {
@@ -131,7 +139,14 @@ Evaluation evaluate(const Recipe& recipe, const Plan& plan, const BuiltInputs& i
 
   // Refuse what cannot fit before building anything large.
   Box3 extent;
-  for (const std::string& name : plan.inputs) extent.expand(bounding_box(inputs.at(name).geometry));
+  for (const std::string& name : plan.inputs) {
+    const Box3 box = bounding_box(inputs.at(name).geometry);
+    // An empty input would vanish from unions and infills without a word.
+    if (box.empty())
+      throw InvalidInput(recipe.file + ": " + input_named(recipe, name).json_path +
+                         ": makes no geometry at all (every piece was dropped or nothing lies in its box)");
+    extent.expand(box);
+  }
   double reach = 0;
   for (int k = 0; k < 3; ++k) reach = std::max({reach, std::fabs(extent.min[k]), std::fabs(extent.max[k])});
   if (reach / vopt.voxel_size_mm > kMaxCoordinateInVoxels)

@@ -3,11 +3,13 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
+#include "errors.h"
 #include "export/fea.h"
 #include "export/mesh_io.h"
 #include "export/output_files.h"
 #include "export/report.h"
 #include "solids/simplify.h"
+#include "util/system.h"
 
 namespace lacuna {
 
@@ -25,6 +27,7 @@ FeaResult make_fea_mesh(const TriMesh& surface, const FeaSettings& settings, con
   options.max_tet_volume_mm3 = settings.max_tet_volume_mm3;
   options.preserve_surface = settings.preserve_surface;
   options.time_limit_s = settings.time_limit_s;
+  options.max_memory_bytes = settings.max_memory_bytes ? settings.max_memory_bytes : available_memory_bytes() / 2;
   result.mesh = tetrahedralize(surface, options, region_seeds);
   r.report = tet_report(result.mesh);
   if (r.report.tets == 0) r.problems.push_back("TetGen produced no tetrahedra");
@@ -36,8 +39,8 @@ FeaResult make_fea_mesh(const TriMesh& surface, const FeaSettings& settings, con
   const bool preserved = options.preserve_surface && options.max_radius_edge_ratio == 0 && options.max_tet_volume_mm3 == 0;
   const double tolerance = preserved ? 1e-6 : 1e-5;
   if (std::fabs(r.report.volume_mm3 - expected) > tolerance * expected)
-    r.problems.push_back("the tetrahedra's volume " + std::to_string(r.report.volume_mm3) +
-                         " mm3 differs from the surface's " + std::to_string(expected) + " mm3");
+    r.problems.push_back("the tetrahedra's volume " + message_number(r.report.volume_mm3) +
+                         " mm3 differs from the surface's " + message_number(expected) + " mm3");
   if (settings.max_tet_volume_mm3 > 0 && r.report.max_tet_volume_mm3 > settings.max_tet_volume_mm3 * (1 + 1e-9))
     r.problems.push_back("a tetrahedron exceeds the volume bound");
   return result;

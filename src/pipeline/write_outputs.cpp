@@ -101,10 +101,25 @@ ThreeMfInfo package_info(const Recipe& recipe) {
   return info;
 }
 
+// Throws an error of the same kind as `e` with another message.
+[[noreturn]] void rethrow_with_message(const Error& e, const std::string& message) {
+  if (dynamic_cast<const InvalidInput*>(&e)) throw InvalidInput(message);
+  if (dynamic_cast<const IoError*>(&e)) throw IoError(message);
+  if (dynamic_cast<const ResourceLimit*>(&e)) throw ResourceLimit(message);
+  if (dynamic_cast<const CheckFailed*>(&e)) throw CheckFailed(message);
+  if (dynamic_cast<const Cancelled*>(&e)) throw Cancelled(message);
+  if (dynamic_cast<const InternalError*>(&e)) throw InternalError(message);
+  throw Error(message);
+}
+
 }  // namespace
 
 std::string output_folder(const Recipe& recipe, const WriteOptions& options) {
   return options.output_dir.empty() ? recipe.name + "-out" : options.output_dir;
+}
+
+std::unique_ptr<OutputFolder> hold_output_folder(const Recipe& recipe, const WriteOptions& options) {
+  return std::make_unique<OutputFolder>(output_folder(recipe, options));
 }
 
 void check_output_folder(const Recipe& recipe, const WriteOptions& options) {
@@ -121,11 +136,11 @@ RunReport write_outputs(const Recipe& recipe, const Plan& plan, Evaluation&& eva
   const VolumeOptions vopt{recipe.voxel_size_mm, recipe.band_voxels};
   const uint64_t budget = evaluation.memory_budget_bytes;
   const fs::path out_dir = output_folder(recipe, options);
-  std::error_code ec;
-  bool created_dir = !fs::exists(out_dir, ec);
-  if (!created_dir && !fs::is_directory(out_dir, ec)) throw IoError(out_dir.string() + ": exists and is not a folder");
-  fs::create_directories(out_dir, ec);
-  if (ec) throw IoError(out_dir.string() + ": cannot create the output folder: " + ec.message());
+  // Created (with its parents) and locked here unless the caller holds it already; removed again
+  // when this job created it and fails.
+  std::optional<OutputFolder> own_folder;
+  if (!options.folder) own_folder.emplace(out_dir.string());
+  OutputFolder& folder = options.folder ? *options.folder : *own_folder;
 
   OutputTransaction transaction;
   RunReport report;
@@ -243,7 +258,9 @@ RunReport write_outputs(const Recipe& recipe, const Plan& plan, Evaluation&& eva
           continue;
         }
         timer.start("tetrahedralize");
-        FeaResult fea = make_fea_mesh(surface, out.fea);
+        FeaSettings fea_settings = out.fea;
+        fea_settings.max_memory_bytes = budget;
+        FeaResult fea = make_fea_mesh(surface, fea_settings);
         if (fea.check.valid() && !out.fea.regions.empty()) {
           std::vector<Volume> regions;
           for (const std::string& name : out.fea.regions) regions.push_back(evaluation.volumes.at(name));
@@ -299,19 +316,28 @@ RunReport write_outputs(const Recipe& recipe, const Plan& plan, Evaluation&& eva
     for (size_t i = 0; i < inputs.names.size(); ++i) report.inputs.emplace_back(inputs.names[i], inputs.inputs[i].report);
     if (!report.valid) {
       transaction.rollback();
-      if (created_dir) fs::remove(out_dir, ec);
       return report;
     }
     const std::string report_path = (out_dir / "report.json").string();
     if (options.write_report)
       write_text_file_atomically(transaction.stage(report_path), to_json(report).dump(2) + "\n");
     transaction.commit();
+    folder.keep();
     for (const OutputReport& o : report.outputs) report.written.push_back(o.file);
     if (options.write_report) report.written.push_back(report_path);
     return report;
+  } catch (const Error& e) {
+    transaction.rollback();
+    // Messages name the files the user asked for, not their hidden temporaries.
+    std::string message = e.what();
+    for (const auto& [temp, final_path] : transaction.names()) {
+      for (size_t at = message.find(temp); at != std::string::npos; at = message.find(temp, at + final_path.size()))
+        message.replace(at, temp.size(), final_path);
+    }
+    if (message == e.what()) throw;
+    rethrow_with_message(e, message);
   } catch (...) {
     transaction.rollback();
-    if (created_dir) fs::remove(out_dir, ec);
     throw;
   }
 }

@@ -172,9 +172,12 @@ NurbsAutomaton parse_nurbs(const JsonObject& o) {
   }
 }
 
-}  // namespace
+// Systems nested in systems ("product", "restrict", "library") at most this deep.
+constexpr int kMaxSystemDepth = 16;
 
-Cifs parse_system(const nlohmann::json& value, const std::string& file, const std::string& path) {
+Cifs parse_system_at(const nlohmann::json& value, const std::string& file, const std::string& path, int depth) {
+  if (depth > kMaxSystemDepth)
+    throw InvalidInput(file + ": systems nest deeper than " + std::to_string(kMaxSystemDepth) + " levels (product, restrict)");
   if (value.is_string()) {
     try {
       return library_system(value.get<std::string>());
@@ -192,7 +195,7 @@ Cifs parse_system(const nlohmann::json& value, const std::string& file, const st
   Cifs c;
   bool needs_points = false;
   if (o.has("library")) {
-    c = parse_system(o.required("library"), file, o.path_of("library"));
+    c = parse_system_at(o.required("library"), file, o.path_of("library"), depth + 1);
   } else if (o.has("states")) {
     c.automaton = parse_automaton(o, true);
     needs_points = true;
@@ -207,8 +210,8 @@ Cifs parse_system(const nlohmann::json& value, const std::string& file, const st
   } else if (o.has("product")) {
     const nlohmann::json& pair = o.required("product");
     if (!pair.is_array() || pair.size() != 2) o.fail("product", "expected a list of two systems");
-    Cifs a = parse_system(pair[0], file, o.path_of("product[0]"));
-    Cifs b = parse_system(pair[1], file, o.path_of("product[1]"));
+    Cifs a = parse_system_at(pair[0], file, o.path_of("product[0]"), depth + 1);
+    Cifs b = parse_system_at(pair[1], file, o.path_of("product[1]"), depth + 1);
     if (a.rational || b.rational) o.fail("product", "rational factors: give the product's control points instead");
     try {
       c.automaton = tensor_product(a.automaton, b.automaton);
@@ -221,7 +224,7 @@ Cifs parse_system(const nlohmann::json& value, const std::string& file, const st
       for (Eigen::Index j = 0; j < b.control_points.cols(); ++j)
         c.control_points.col(i * b.control_points.cols() + j) = a.control_points.col(i) + b.control_points.col(j);
   } else {
-    Cifs inner = parse_system(o.required("restrict"), file, o.path_of("restrict"));
+    Cifs inner = parse_system_at(o.required("restrict"), file, o.path_of("restrict"), depth + 1);
     Automaton pattern;
     if (o.has("drop_symbols") == o.has("pattern")) o.fail("", "give either \"drop_symbols\" or \"pattern\" with \"restrict\"");
     if (o.has("drop_symbols")) {
@@ -265,17 +268,20 @@ Cifs parse_system(const nlohmann::json& value, const std::string& file, const st
   return c;
 }
 
+}  // namespace
+
+Cifs parse_system(const nlohmann::json& value, const std::string& file, const std::string& path) {
+  return parse_system_at(value, file, path, 0);
+}
+
 Cifs load_system(const std::string& name_or_file) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(name_or_file, ec)) {
+  if (!std::filesystem::exists(name_or_file, ec)) {
     if (name_or_file.size() > 5 && name_or_file.substr(name_or_file.size() - 5) == ".json")
       throw IoError(name_or_file + ": cannot open the system file");
     return library_system(name_or_file);
   }
-  std::ifstream in(name_or_file, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_system(parse_json_text(text.str(), name_or_file), name_or_file, "");
+  return parse_system(read_json_file(name_or_file, "a system file (.json)"), name_or_file, "");
 }
 
 nlohmann::json system_json(const Cifs& c) {

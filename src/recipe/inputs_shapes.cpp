@@ -75,8 +75,9 @@ SpheresInput parse_spheres_input(const JsonObject& o) {
   if (o.has("radius_mm") == o.has("radii_mm")) o.fail("", "give either \"radius_mm\" or \"radii_mm\"");
   if (o.has("radius_mm")) s.radii_mm = {o.positive_length("radius_mm")};
   else s.radii_mm = o.positive_length_list("radii_mm");
-  if (s.radii_mm.size() != 1 && s.radii_mm.size() != s.centers_mm.size())
-    o.fail("radii_mm", "expected one radius per centre (" + std::to_string(s.centers_mm.size()) + ")");
+  if (o.has("radii_mm") && s.radii_mm.size() != s.centers_mm.size())
+    o.fail("radii_mm", "expected one radius per centre (" + std::to_string(s.centers_mm.size()) + "), got " +
+                           std::to_string(s.radii_mm.size()) + "; give \"radius_mm\" for one radius for all");
   return s;
 }
 
@@ -102,8 +103,9 @@ TubesInput parse_tubes_input(const JsonObject& o) {
     if (p.has("radius_mm") == p.has("radii_mm")) p.fail("", "give either \"radius_mm\" or \"radii_mm\"");
     if (p.has("radius_mm")) tube.radii_mm = {p.positive_length("radius_mm")};
     else tube.radii_mm = p.positive_length_list("radii_mm");
-    if (tube.radii_mm.size() != 1 && tube.radii_mm.size() != tube.points_mm.size())
-      p.fail("radii_mm", "expected one radius per point (" + std::to_string(tube.points_mm.size()) + ")");
+    if (p.has("radii_mm") && tube.radii_mm.size() != tube.points_mm.size())
+      p.fail("radii_mm", "expected one radius per point (" + std::to_string(tube.points_mm.size()) + "), got " +
+                             std::to_string(tube.radii_mm.size()) + "; give \"radius_mm\" for one radius for all");
     in.polylines.push_back(std::move(tube));
   }
   return in;

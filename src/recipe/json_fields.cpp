@@ -6,6 +6,7 @@
 
 #include "errors.h"
 #include "util/suggest.h"
+#include "util/system.h"
 
 namespace lacuna {
 namespace {
@@ -33,10 +34,14 @@ nlohmann::json parse_json_text(const std::string& text, const std::string& file)
   // Duplicate keys are almost always a mistake; nlohmann keeps the last one silently.
   std::vector<std::set<std::string>> keys;
   std::string duplicate;
-  auto callback = [&](int /*depth*/, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
+  auto callback = [&](int depth, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
     switch (event) {
       case nlohmann::json::parse_event_t::object_start:
-        keys.emplace_back();
+      case nlohmann::json::parse_event_t::array_start:
+        // Checked while parsing: what reads the value later recurses into it.
+        if (depth >= kMaxJsonDepth)
+          throw InvalidInput(file + ": JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
+        if (event == nlohmann::json::parse_event_t::object_start) keys.emplace_back();
         break;
       case nlohmann::json::parse_event_t::object_end:
         if (!keys.empty()) keys.pop_back();
@@ -61,6 +66,10 @@ nlohmann::json parse_json_text(const std::string& text, const std::string& file)
   }
   if (!duplicate.empty()) throw InvalidInput(file + ": key \"" + duplicate + "\" appears twice in the same object");
   return value;
+}
+
+nlohmann::json read_json_file(const std::string& path, const std::string& what) {
+  return parse_json_text(read_text_file(path, what, kMaxJsonFileBytes), path);
 }
 
 JsonObject::JsonObject(const nlohmann::json& value, std::string file, std::string path)
@@ -103,6 +112,8 @@ const nlohmann::json& JsonObject::required(const char* key) const {
 std::string JsonObject::string(const char* key) const {
   const nlohmann::json& v = required(key);
   if (!v.is_string()) fail(key, "expected a string, got " + describe_json_type(v));
+  // C file and XML interfaces would cut the text at a NUL and use what is before it.
+  if (v.get_ref<const std::string&>().find('\0') != std::string::npos) fail(key, "a string may not hold a NUL character");
   return v.get<std::string>();
 }
 

@@ -12,9 +12,20 @@
 
 namespace lacuna {
 
-// Parses JSON text (comments allowed) and rejects duplicate keys. Throws InvalidInput with the
-// file, line and column on syntax errors.
+// The largest JSON file read (recipes, systems, control points): larger geometry goes in mesh files.
+constexpr uint64_t kMaxJsonFileBytes = uint64_t{256} << 20;
+// The deepest nesting of JSON arrays and objects read; deeper documents are refused before they are
+// built (a recipe needs about 10 levels, a system of 16 nested products about 40).
+constexpr int kMaxJsonDepth = 64;
+
+// Parses JSON text (comments allowed) and rejects duplicate keys and nesting deeper than
+// kMaxJsonDepth. Throws InvalidInput with the file, line and column on syntax errors.
 nlohmann::json parse_json_text(const std::string& text, const std::string& file);
+
+// Reads and parses the JSON file at `path` (`what` names it in messages: "the recipe file"). Throws
+// IoError for a missing or unreadable file, a folder, a pipe or a device, InvalidInput for a file
+// over kMaxJsonFileBytes (before reading it) and for what parse_json_text() refuses.
+nlohmann::json read_json_file(const std::string& path, const std::string& what);
 
 // One JSON object in a recipe, with its path for messages ("inputs.ball").
 class JsonObject {

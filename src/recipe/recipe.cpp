@@ -13,6 +13,7 @@
 #include "recipe/input_parsers.h"
 #include "recipe/json_fields.h"
 #include "util/suggest.h"
+#include "util/system.h"
 
 namespace lacuna {
 namespace {
@@ -98,6 +99,17 @@ bool valid_name(const std::string& name) {
   });
 }
 
+bool has_control_character(const std::string& text) {
+  return std::any_of(text.begin(), text.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; });
+}
+
+// A name that becomes one path component: no folder separators, not "." or "..", not hidden (the
+// output transaction's temporaries are hidden), no control characters.
+bool plain_file_name(const std::string& name) {
+  return !name.empty() && name.find('/') == std::string::npos && name.find('\\') == std::string::npos &&
+         name != "." && name != ".." && name[0] != '.' && !has_control_character(name) && name.size() <= 200;
+}
+
 std::string lower(std::string s) {
   for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return s;
@@ -119,18 +131,11 @@ std::vector<std::string> input_type_names() {
 }
 
 Recipe load_recipe(const std::string& path) {
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) throw IoError(path + ": is a folder, expected a recipe file (.json)");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError(path + ": cannot open the recipe file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw IoError(path + ": cannot read the recipe file");
-  return parse_recipe(text.str(), path);
+  return parse_recipe(read_text_file(path, "a recipe file (.json)", kMaxJsonFileBytes), path);
 }
 
 Recipe parse_recipe(const std::string& text, const std::string& path) {
-  if (text.size() > (uint64_t{256} << 20))
+  if (text.size() > kMaxJsonFileBytes)
     throw InvalidInput(path + ": recipe is larger than 256 MB; put large geometry in mesh files");
   nlohmann::json root = parse_json_text(text, path);
   JsonObject top(root, path, "");
@@ -141,8 +146,15 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
   if (top.has("lacuna_recipe") && top.unsigned_integer_or("lacuna_recipe", 1) != 1)
     top.fail("lacuna_recipe", "this version of Lacuna reads recipe format 1");
   recipe.name = top.string_or("name", fs::path(path).stem().string());
+  // The default output folder is "<name>-out" in the working folder: the name must stay one plain
+  // folder name there.
+  if (top.has("name") && !plain_file_name(recipe.name))
+    top.fail("name", "expected a plain name such as \"bracket\" (it names the output folder <name>-out): no '/', '\\', "
+                     "control characters or leading '.', at most 200 characters");
   recipe.description = top.string_or("description", "");
   recipe.voxel_size_mm = top.positive_length_or("voxel_size_mm", 0.1);
+  if (!(recipe.voxel_size_mm >= kMinVoxelSizeMm && recipe.voxel_size_mm <= kMaxVoxelSizeMm))
+    top.fail("voxel_size_mm", "expected a voxel size from 0.0001 to 1000 mm");
   recipe.band_voxels = top.number_or("band_voxels", 3.0);
   if (recipe.band_voxels < 2 || recipe.band_voxels > 16) top.fail("band_voxels", "expected a number from 2 to 16");
   if (top.has("simplify_mm")) recipe.simplify_mm = deviation(top, "simplify_mm");
@@ -182,6 +194,7 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
       if (!found) {
         std::vector<std::string> input_names;
         for (const RecipeInput& other : recipe.inputs) input_names.push_back(other.name);
+        if (dep == in.name) throw InvalidInput(path + ": " + in.json_path + ": refers to itself; name another input");
         throw InvalidInput(path + ": " + in.json_path + ": \"" + dep + "\" is not another input" +
                            did_you_mean(dep, input_names));
       }
@@ -306,9 +319,9 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
       known(out.object);
     }
     out.file = o.string("file");
-    if (out.file.empty() || out.file.find('/') != std::string::npos || out.file.find('\\') != std::string::npos ||
-        out.file == "." || out.file == ".." || out.file[0] == '.')
-      o.fail("file", "expected a plain file name such as \"part.stl\" (outputs go to the output folder)");
+    if (!plain_file_name(out.file))
+      o.fail("file", "expected a plain file name such as \"part.stl\" (outputs go to the output folder): no '/', '\\', "
+                     "control characters or leading '.', at most 200 characters");
     std::string ext = lower(fs::path(out.file).extension().string());
     const std::map<std::string, std::string> formats = {{".stl", "stl"}, {".3mf", "3mf"}, {".msh", "msh"},
                                                         {".inp", "inp"}, {".vtu", "vtu"}, {".mesh", "mesh"}};
@@ -356,6 +369,7 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
       }
     }
     out.part_name = o.string_or("name", out.object);
+    if (has_control_character(out.part_name)) o.fail("name", "an object name may not hold control characters");
     recipe.outputs.push_back(std::move(out));
   }
 

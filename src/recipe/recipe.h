@@ -82,6 +82,7 @@ struct FeaSettings {
   bool quadratic = false;             // .inp with C3D10 elements
   std::vector<std::string> regions;   // objects whose insides are material regions 0, 1, ...
   double time_limit_s = 600;
+  uint64_t max_memory_bytes = 0;      // TetGen's memory limit; 0: half the memory available (a run sets its budget)
 };
 
 struct RecipeOutput {

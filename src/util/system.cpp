@@ -1,11 +1,18 @@
 #include "util/system.h"
 
+#include <fcntl.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <sstream>
+
+#include "errors.h"
 
 namespace lacuna {
 
@@ -72,6 +79,42 @@ std::string format_bytes(uint64_t bytes) {
   else if (b >= 1e6) std::snprintf(text, sizeof text, "%.1f MB", b / 1e6);
   else if (b >= 1e3) std::snprintf(text, sizeof text, "%.1f kB", b / 1e3);
   else std::snprintf(text, sizeof text, "%llu B", static_cast<unsigned long long>(bytes));
+  return text;
+}
+
+std::string read_text_file(const std::string& path, const std::string& what, uint64_t max_bytes) {
+  // Non-blocking, so that opening a FIFO does not wait for a writer; fstat then says what it is.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) throw IoError(path + ": cannot open " + what + ": " + std::strerror(errno));
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  struct stat info;
+  if (::fstat(fd, &info) != 0) throw IoError(path + ": cannot read " + what + ": " + std::strerror(errno));
+  if (S_ISDIR(info.st_mode)) throw IoError(path + ": is a folder, expected " + what);
+  if (!S_ISREG(info.st_mode))
+    throw IoError(path + ": is not a regular file (a pipe, socket or device), expected " + what);
+  if (uint64_t(info.st_size) > max_bytes)
+    throw InvalidInput(path + ": " + what + " is larger than " + format_bytes(max_bytes) + " (" +
+                       format_bytes(uint64_t(info.st_size)) + ")");
+  ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);
+  std::string text(size_t(info.st_size), '\0');
+  size_t done = 0;
+  // A file that grows while it is read is read up to the limit and refused beyond it.
+  for (;;) {
+    if (done == text.size()) {
+      if (text.size() >= max_bytes)
+        throw InvalidInput(path + ": " + what + " is larger than " + format_bytes(max_bytes));
+      text.resize(std::min<uint64_t>(max_bytes, std::max<uint64_t>(4096, 2 * text.size())));
+    }
+    const ssize_t n = ::read(fd, &text[done], text.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) throw IoError(path + ": cannot read " + what + ": " + std::strerror(errno));
+    if (n == 0) break;
+    done += size_t(n);
+  }
+  text.resize(done);
   return text;
 }
 

@@ -41,4 +41,10 @@ class StageTimer {
 // Formats a byte count for messages, e.g. "3.2 GB".
 std::string format_bytes(uint64_t bytes);
 
+// The whole content of the regular file at `path` (`what` names it in messages, e.g. "the recipe
+// file"). Refuses folders, pipes and devices without opening them for reading (a FIFO would block, a
+// device never ends), and files over `max_bytes` before reading them. Throws IoError when the file is
+// missing, unreadable or not a regular file, InvalidInput when it is larger than `max_bytes`.
+std::string read_text_file(const std::string& path, const std::string& what, uint64_t max_bytes);
+
 }  // namespace lacuna

@@ -61,7 +61,7 @@ std::vector<double> perron_vector(const Eigen::MatrixXd& matrix, double dn) {
   const double residual = (matrix * a - dn * a).cwiseAbs().maxCoeff();
   if (!(residual <= 1e-9 * dn))
     throw std::logic_error("voronoi: the limit measures are not an eigenvector of M for d^n (residual " +
-                           std::to_string(residual) + ")");
+                           message_number(residual) + ")");
   return std::vector<double>(a.data(), a.data() + m);
 }
 
@@ -312,7 +312,7 @@ Rules make_rules(int n, int d, const std::vector<std::vector<double>>& points, c
   if (m == 0) throw InvalidInput("voronoi: at least one starting point is needed");
   const double dn_real = std::pow(double(d), n);
   if (dn_real * double(m) > kMaxRuleChildren)
-    throw ResourceLimit("voronoi: d^n m = " + std::to_string(dn_real * double(m)) + " rule children exceed the " +
+    throw ResourceLimit("voronoi: d^n m = " + message_number(dn_real * double(m)) + " rule children exceed the " +
                         "limit of 1e6; use fewer points or a smaller d");
   if (m > size_t(kMaxStartingPoints))
     throw ResourceLimit("voronoi: " + std::to_string(m) + " starting points exceed the limit of " +

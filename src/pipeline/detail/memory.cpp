@@ -17,10 +17,12 @@ std::string fixed(double v, int digits) {
 }
 
 std::string refusal(const std::string& what, uint64_t need, uint64_t budget, const VolumeOptions& vopt) {
-  double scale = std::sqrt(double(need) / double(budget)) * 1.05;
-  return what + " needs about " + format_bytes(need) + ", more than the budget of " + format_bytes(budget) +
-         " (--max-memory); a voxel size of " + fixed(vopt.voxel_size_mm * scale, 3) + " mm or larger would fit" +
-         " (now " + fixed(vopt.voxel_size_mm, 4) + " mm)";
+  const double scale = std::sqrt(double(need) / double(budget)) * 1.05;
+  const double fits = vopt.voxel_size_mm * scale;
+  const std::string head = what + " needs about " + format_bytes(need) + ", more than the budget of " +
+                           format_bytes(budget) + " (--max-memory); ";
+  if (!(fits <= kMaxVoxelSizeMm)) return head + "no voxel size would make it fit (now " + fixed(vopt.voxel_size_mm, 4) + " mm)";
+  return head + "a voxel size of " + fixed(fits, 3) + " mm or larger would fit (now " + fixed(vopt.voxel_size_mm, 4) + " mm)";
 }
 
 void require_mesh_memory(const Volume& v, uint64_t budget, const std::string& what, const VolumeOptions& vopt,
