@@ -25,11 +25,14 @@ class OutputTransaction {
   void commit();
   // Removes every staged temporary file.
   void rollback();
-  // (temporary, final) path of every staged file, for messages.
-  std::vector<std::pair<std::string, std::string>> names() const {
-    std::vector<std::pair<std::string, std::string>> out;
-    for (const Entry& e : entries_) out.emplace_back(e.temp_path, e.final_path);
-    return out;
+  // `message` with every staged temporary's path replaced by its final path: errors of the writers
+  // and readers name the files the user asked for, not their hidden temporaries.
+  std::string with_final_names(std::string message) const {
+    for (const Entry& e : entries_)
+      for (size_t at = message.find(e.temp_path); at != std::string::npos;
+           at = message.find(e.temp_path, at + e.final_path.size()))
+        message.replace(at, e.temp_path.size(), e.final_path);
+    return message;
   }
 
  private:

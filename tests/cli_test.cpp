@@ -14,6 +14,7 @@
 
 #include "fill/fill.h"
 #include <regex>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -108,6 +109,13 @@ TEST_P(Sample, RunsAndEveryOutputPassesTheChecks) {
   ASSERT_TRUE(fs::exists(out / "report.json"));
   EXPECT_EQ(nlohmann::json::parse(read_file(out / "report.json"))["outputs"].size(), report["outputs"].size());
   ASSERT_FALSE(report["outputs"].empty());
+  // Clients an output needed that are not installed: the test is then reported as skipped, not passed.
+  std::set<std::string> missing;
+  auto client = [&](const char* program) {
+    if (have(program)) return true;
+    missing.insert(program);
+    return false;
+  };
   for (const auto& o : report["outputs"]) {
     const std::string file = o["file"].get<std::string>();
     ASSERT_TRUE(fs::exists(file)) << file;
@@ -117,7 +125,7 @@ TEST_P(Sample, RunsAndEveryOutputPassesTheChecks) {
       EXPECT_GT(o["tets"].get<uint64_t>(), 0u);
       EXPECT_NEAR(o["volume_mm3"].get<double>(), o["surface_volume_mm3"].get<double>(),
                   1e-5 * o["surface_volume_mm3"].get<double>());
-      if (o["format"] == "msh" && have("gmsh")) {
+      if (o["format"] == "msh" && client("gmsh")) {
         Result g = run("gmsh -0 " + quote(file) + " -o " + quote((dir / "g.msh").string()) + " -format msh22 -save_all",
                        dir.path());
         EXPECT_EQ(g.code, 0) << g.out << g.err;
@@ -131,7 +139,7 @@ TEST_P(Sample, RunsAndEveryOutputPassesTheChecks) {
     EXPECT_EQ(cj["triangles"], o["triangles"]);
     EXPECT_EQ(cj["components"], o["components"]);
     EXPECT_EQ(cj["genus"], o["genus"]);
-    if (have("prusa-slicer")) {
+    if (client("prusa-slicer")) {
       Result p = run("prusa-slicer --info " + quote(file), dir.path());
       EXPECT_EQ(p.code, 0) << p.err;
       EXPECT_NE(p.out.find("manifold = yes"), std::string::npos) << file << "\n" << p.out;
@@ -155,7 +163,7 @@ TEST_P(Sample, RunsAndEveryOutputPassesTheChecks) {
       EXPECT_EQ(uint64_t(sum_of("number_of_facets = ([0-9]+)")), o["triangles"].get<uint64_t>());
       EXPECT_NEAR(sum_of("volume = ([0-9.eE+-]+)"), o["volume_mm3"].get<double>(), 1e-3 * o["volume_mm3"].get<double>());
     }
-    if (have("admesh") && o["format"] == "stl") {
+    if (o["format"] == "stl" && client("admesh")) {
       Result a = run("admesh " + quote(file), dir.path());
       for (const char* counter : {"Degenerate facets", "Edges fixed", "Facets removed", "Facets added",
                                   "Facets reversed", "Backwards edges", "Normals fixed"}) {
@@ -164,6 +172,11 @@ TEST_P(Sample, RunsAndEveryOutputPassesTheChecks) {
         EXPECT_EQ(m[1].str(), "0") << file << ": " << counter;
       }
     }
+  }
+  if (!missing.empty()) {
+    std::string names;
+    for (const std::string& m : missing) names += (names.empty() ? "" : ", ") + m;
+    GTEST_SKIP() << "the outputs passed Lacuna's own checks, but " << names << " (not installed) did not read them";
   }
 }
 

@@ -213,8 +213,14 @@ class Builder {
     HullFields fields;
     if (l.lattice.grade.kind == GradeField::Kind::kDepth) fields.depth_mm = depth_in(hull, l.lattice.grade.depth_mm);
     if (l.lattice.layout == LatticeOptions::Layout::kConforming) {
-      // Nodes up to a cell outside, and the inset surface, must lie in the field's band.
+      // Nodes up to a cell outside, and the inset surface, must lie in the field's band; nothing in
+      // the hull is deeper than half its box's smallest side.
       const double period = l.lattice.period_mm;
+      const Vec3d size = box_of(hull).size();
+      const double deepest = 0.5 * std::min({size.x, size.y, size.z});
+      if (l.lattice.conform_inset_mm >= deepest)
+        fail("inset_mm", "no strut is left: an inset of " + message_number(l.lattice.conform_inset_mm) +
+                             " mm is deeper than anything in \"" + hull + "\" (at most " + message_number(deepest) + " mm)");
       fields.signed_distance_mm = signed_distance_in(hull, l.lattice.conform_inset_mm + period, period);
     }
     try {

@@ -64,8 +64,13 @@ TetCheck write_tetrahedra(const TriMesh& surface, const std::string& output_path
   FeaWriteOptions w;
   w.msh_version_2 = settings.msh_version_2;
   w.quadratic = settings.quadratic;
-  write_fea(transaction.stage(output_path), fea_format_from_path(output_path), fea.mesh, w);
-  transaction.commit();
+  try {
+    write_fea(transaction.stage(output_path), fea_format_from_path(output_path), fea.mesh, w);
+    transaction.commit();
+  } catch (const IoError& e) {
+    // Named as the file asked for, not its hidden temporary.
+    throw IoError(transaction.with_final_names(e.what()));
+  }
   return fea.check;
 }
 

@@ -329,11 +329,7 @@ RunReport write_outputs(const Recipe& recipe, const Plan& plan, Evaluation&& eva
   } catch (const Error& e) {
     transaction.rollback();
     // Messages name the files the user asked for, not their hidden temporaries.
-    std::string message = e.what();
-    for (const auto& [temp, final_path] : transaction.names()) {
-      for (size_t at = message.find(temp); at != std::string::npos; at = message.find(temp, at + final_path.size()))
-        message.replace(at, temp.size(), final_path);
-    }
+    const std::string message = transaction.with_final_names(e.what());
     if (message == e.what()) throw;
     rethrow_with_message(e, message);
   } catch (...) {

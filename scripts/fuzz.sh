@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# The libFuzzer targets (fuzz/: recipe parser, CIFS systems, STL/OBJ/PLY/3MF readers), built with
+# Debian's clang in build-fuzz/ and run for SECONDS each (default 20), then every file of the
+# regression corpus tests/fuzz_corpus/ once. A crash leaves its input as build-fuzz/fuzz/<target>-crash-*:
+# copy it into tests/fuzz_corpus/<target>/ with the fix.
+#
+#   scripts/fuzz.sh [SECONDS]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds="${1:-20}"
+CXX=clang++ CC=clang cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLACUNA_FUZZ=ON \
+    -DLACUNA_BUILD_TESTS=OFF -DLACUNA_BUILD_BENCH=OFF -DLACUNA_BUILD_PYTHON=OFF -DLACUNA_FUZZ_SECONDS="$seconds" \
+    -DPython_EXECUTABLE=/usr/bin/python3 >/dev/null
+cmake --build build-fuzz -j "$(nproc)" --target recipe_fuzz cifs_system_fuzz mesh_fuzz
+cd build-fuzz && exec ctest --output-on-failure -L fuzz
