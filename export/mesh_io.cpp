@@ -788,7 +788,8 @@ TriMesh read_ply(InputFile& file, const ReadOptions& options) {
         property.name = std::string(tokens[4]);
       } else {
         ok = tokens.size() == 3 && parse_ply_type(tokens[1], property.type);
-        property.name = std::string(tokens[2]);
+        // (tokens beyond size() are views into an earlier line, freed since.)
+        if (ok) property.name = std::string(tokens[2]);
       }
       if (!ok) {
         bad(

@@ -369,6 +369,12 @@ TEST(Robustness, MeshReadersAreStrict) {
   EXPECT_EQ(extra.code, 2) << extra.err;
   EXPECT_NE(extra.err.find("line 18: more data than the header declares 4 vertices and 4 faces"), std::string::npos)
       << extra.err;
+  // Found by mesh_fuzz: a property line of the wrong length after a longer line read freed memory.
+  write_file(dir / "short.ply", "ply\nformat ascii 1.0\ncomment a line of many words before\nelement vertex 1\n"
+                                "property float\nend_header\n");
+  Result short_line = lacuna("check " + quote((dir / "short.ply").string()), dir.path());
+  EXPECT_EQ(short_line.code, 2) << short_line.err;
+  EXPECT_NE(short_line.err.find("expected 'property <type> <name>'"), std::string::npos) << short_line.err;
 }
 
 // --- interruption and concurrency ---------------------------------------------------------------
