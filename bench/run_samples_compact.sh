@@ -8,7 +8,10 @@ build="${1:-build}"
 shift || true
 samples=("$@")
 if [ "${#samples[@]}" -eq 0 ]; then
-  for f in samples/*.json; do samples+=("$(basename "$f" .json)"); done
+  for f in samples/*.json; do
+    case "$f" in *.expected.json) continue ;; esac
+    samples+=("$(basename "$f" .json)")
+  done
 fi
 command -v prusa-slicer >/dev/null || { echo "prusa-slicer is not installed" >&2; exit 2; }
 out="$(mktemp -d)"

@@ -691,6 +691,99 @@ class RegionSimplifier {
       return false;
     }
     const bool keep_moves = target != pos_[keep];
+    // The triangles that change: drop's (renamed), and keep's when keep moves. None may be worse
+    // shaped than the worst it replaces unless it stays above kMinQuality: exact tests keep even a
+    // needle valid, but slicers, viewers and meshers recompute its normal in float and trip on it.
+    double old_quality = std::min(quality(pos_[tri_[t1][0]], pos_[tri_[t1][1]], pos_[tri_[t1][2]]),
+                                  quality(pos_[tri_[t2][0]], pos_[tri_[t2][1]], pos_[tri_[t2][2]]));
+    double new_quality = HUGE_VAL;
+    changed_.clear();
+    changed_ids_.clear();
+    changed_pos_.clear();
+    changed_box_.clear();
+    for (uint32_t c : new_fan_) {
+      const uint32_t t = tri_of(c);
+      const auto& old = tri_[t];
+      const bool of_drop = old[0] == drop || old[1] == drop || old[2] == drop;
+      if (!of_drop && !keep_moves) continue;
+      const std::array<uint32_t, 3> ids{rename(old[0]), rename(old[1]), rename(old[2])};
+      const std::array<Vec3d, 3> p{at(ids[0], keep, target), at(ids[1], keep, target), at(ids[2], keep, target)};
+      if (exact::collinear(p[0], p[1], p[2])) return false;
+      const Vec3d n_old = cross(pos_[old[1]] - pos_[old[0]], pos_[old[2]] - pos_[old[0]]);
+      const Vec3d n_new = cross(p[1] - p[0], p[2] - p[0]);
+      if (dot(n_old, n_new) <= cos_normal_ * norm(n_old) * norm(n_new)) return false;
+      old_quality = std::min(old_quality, quality(pos_[old[0]], pos_[old[1]], pos_[old[2]]));
+      new_quality = std::min(new_quality, quality(p[0], p[1], p[2]));
+      changed_.push_back(t);
+      changed_ids_.push_back(ids);
+      changed_pos_.push_back(p);
+      changed_box_.push_back(tri_box(p));
+    }
+
+    if (new_quality < std::min(kMinQuality, old_quality)) return false;
+
+    // Pairs sharing a vertex whose fan is a graph over a coordinate plane meet only in what they
+    // share. keep's new fan is checked whole; a neighbour whose fan was a graph stays one when
+    // its changed triangles keep the orientation: its changed stretch (two triangles) spans the
+    // same angle as before, since both spans lie below a full turn and agree modulo one.
+    const uint8_t keep_state = graph_state(target, new_fan_, rename, [&](uint32_t x) { return at(x, keep, target); },
+                                           graph_axis_[keep] != kUnknownAxis ? graph_axis_[keep] : graph_axis_[drop]);
+    touched_.clear();
+    if (++touch_now_ == 0) {
+      std::fill(touch_stamp_.begin(), touch_stamp_.end(), 0);
+      touch_now_ = 1;
+    }
+    for (size_t i = 0; i < changed_.size(); ++i)
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t w = changed_ids_[i][size_t(k)];
+        if (w == keep) continue;
+        if (touch_stamp_[w] != touch_now_) {
+          touch_stamp_[w] = touch_now_;
+          touched_.push_back(w);
+          touch_state_[w] = graph_axis_[w];
+          if (touch_state_[w] == kUnknownAxis) {
+            // Not known: the whole fan as it will be (without t1 and t2).
+            fan_scratch_.clear();
+            if (walk_fan(w, nullptr, &fan_scratch_)) {
+              fan_scratch_.erase(std::remove_if(fan_scratch_.begin(), fan_scratch_.end(),
+                                                [&](uint32_t c) { return tri_of(c) == t1 || tri_of(c) == t2; }),
+                                 fan_scratch_.end());
+              touch_state_[w] = graph_state(pos_[w], fan_scratch_, rename, [&](uint32_t x) { return at(x, keep, target); });
+            }
+            touch_checked_[w] = 1;  // the whole fan was checked: no triangle to test on its own
+            continue;
+          }
+          touch_checked_[w] = 0;
+        }
+        if (touch_checked_[w] || touch_state_[w] == kUnknownAxis) continue;
+        if (!keeps_graph(touch_state_[w], changed_pos_[i][size_t(k)], changed_pos_[i][size_t((k + 1) % 3)],
+                         changed_pos_[i][size_t((k + 2) % 3)]))
+          touch_state_[w] = kUnknownAxis;
+      }
+    auto verified = [&](uint32_t x) {
+      if (x == keep) return keep_state != kUnknownAxis;
+      return (touch_stamp_[x] == touch_now_ ? touch_state_[x] : graph_axis_[x]) != kUnknownAxis;
+    };
+    auto shares_verified = [&](const std::array<uint32_t, 3>& x, const std::array<uint32_t, 3>& y) {
+      for (uint32_t v : x)
+        if ((v == y[0] || v == y[1] || v == y[2]) && verified(v)) return true;
+      return false;
+    };
+    auto meets = [&](size_t i, const std::array<uint32_t, 3>& ids) {
+      return !shares_verified(changed_ids_[i], ids) &&
+             exact::faces_intersect(changed_pos_[i], changed_ids_[i], {pos_[ids[0]], pos_[ids[1]], pos_[ids[2]]}, ids);
+    };
+    // The changed triangles all hold keep: one graph fan covers every pair of them.
+    for (size_t i = 0; i < changed_.size() && keep_state == kUnknownAxis; ++i)
+      for (size_t j = i + 1; j < changed_.size(); ++j) {
+        if (shares_verified(changed_ids_[i], changed_ids_[j])) continue;
+        if (exact::faces_intersect(changed_pos_[i], changed_ids_[i], changed_pos_[j], changed_ids_[j])) {
+          ++rejected_intersection_;
+          return false;
+        }
+      }
+    // The deviation tests last: they cost the most, and the cheaper tests above refuse most
+    // of the collapses that fail.
     // The points that leave the surface (drop, and keep's old place when it moves) stay within
     // the deviation of the new fan: plane distances alone miss a spike folded into its base.
     {
@@ -753,37 +846,6 @@ class RegionSimplifier {
           if (!ring_keeps_points(r)) return false;
     }
 
-    // The triangles that change: drop's (renamed), and keep's when keep moves. None may be worse
-    // shaped than the worst it replaces unless it stays above kMinQuality: exact tests keep even a
-    // needle valid, but slicers, viewers and meshers recompute its normal in float and trip on it.
-    double old_quality = std::min(quality(pos_[tri_[t1][0]], pos_[tri_[t1][1]], pos_[tri_[t1][2]]),
-                                  quality(pos_[tri_[t2][0]], pos_[tri_[t2][1]], pos_[tri_[t2][2]]));
-    double new_quality = HUGE_VAL;
-    changed_.clear();
-    changed_ids_.clear();
-    changed_pos_.clear();
-    changed_box_.clear();
-    for (uint32_t c : new_fan_) {
-      const uint32_t t = tri_of(c);
-      const auto& old = tri_[t];
-      const bool of_drop = old[0] == drop || old[1] == drop || old[2] == drop;
-      if (!of_drop && !keep_moves) continue;
-      const std::array<uint32_t, 3> ids{rename(old[0]), rename(old[1]), rename(old[2])};
-      const std::array<Vec3d, 3> p{at(ids[0], keep, target), at(ids[1], keep, target), at(ids[2], keep, target)};
-      if (exact::collinear(p[0], p[1], p[2])) return false;
-      const Vec3d n_old = cross(pos_[old[1]] - pos_[old[0]], pos_[old[2]] - pos_[old[0]]);
-      const Vec3d n_new = cross(p[1] - p[0], p[2] - p[0]);
-      if (dot(n_old, n_new) <= cos_normal_ * norm(n_old) * norm(n_new)) return false;
-      old_quality = std::min(old_quality, quality(pos_[old[0]], pos_[old[1]], pos_[old[2]]));
-      new_quality = std::min(new_quality, quality(p[0], p[1], p[2]));
-      changed_.push_back(t);
-      changed_ids_.push_back(ids);
-      changed_pos_.push_back(p);
-      changed_box_.push_back(tri_box(p));
-    }
-
-    if (new_quality < std::min(kMinQuality, old_quality)) return false;
-
     // The new triangles stay near the old surface: each centroid, and the midpoint of every edge
     // from the new vertex, within the deviation of the old fans (vertex tests alone let a
     // triangle bridge a concave crease or a sliver).
@@ -800,66 +862,6 @@ class RegionSimplifier {
     for (uint32_t c : new_fan_)
       if (!near_old_surface((target + pos_[rename(to(c))]) * 0.5)) return false;
 
-    // Pairs sharing a vertex whose fan is a graph over a coordinate plane meet only in what they
-    // share. keep's new fan is checked whole; a neighbour whose fan was a graph stays one when
-    // its changed triangles keep the orientation: its changed stretch (two triangles) spans the
-    // same angle as before, since both spans lie below a full turn and agree modulo one.
-    const uint8_t keep_state = graph_state(target, new_fan_, rename, [&](uint32_t x) { return at(x, keep, target); },
-                                           graph_axis_[keep] != kUnknownAxis ? graph_axis_[keep] : graph_axis_[drop]);
-    touched_.clear();
-    if (++touch_now_ == 0) {
-      std::fill(touch_stamp_.begin(), touch_stamp_.end(), 0);
-      touch_now_ = 1;
-    }
-    for (size_t i = 0; i < changed_.size(); ++i)
-      for (int k = 0; k < 3; ++k) {
-        const uint32_t w = changed_ids_[i][size_t(k)];
-        if (w == keep) continue;
-        if (touch_stamp_[w] != touch_now_) {
-          touch_stamp_[w] = touch_now_;
-          touched_.push_back(w);
-          touch_state_[w] = graph_axis_[w];
-          if (touch_state_[w] == kUnknownAxis) {
-            // Not known: the whole fan as it will be (without t1 and t2).
-            fan_scratch_.clear();
-            if (walk_fan(w, nullptr, &fan_scratch_)) {
-              fan_scratch_.erase(std::remove_if(fan_scratch_.begin(), fan_scratch_.end(),
-                                                [&](uint32_t c) { return tri_of(c) == t1 || tri_of(c) == t2; }),
-                                 fan_scratch_.end());
-              touch_state_[w] = graph_state(pos_[w], fan_scratch_, rename, [&](uint32_t x) { return at(x, keep, target); });
-            }
-            touch_checked_[w] = 1;  // the whole fan was checked: no triangle to test on its own
-            continue;
-          }
-          touch_checked_[w] = 0;
-        }
-        if (touch_checked_[w] || touch_state_[w] == kUnknownAxis) continue;
-        if (!keeps_graph(touch_state_[w], changed_pos_[i][size_t(k)], changed_pos_[i][size_t((k + 1) % 3)],
-                         changed_pos_[i][size_t((k + 2) % 3)]))
-          touch_state_[w] = kUnknownAxis;
-      }
-    auto verified = [&](uint32_t x) {
-      if (x == keep) return keep_state != kUnknownAxis;
-      return (touch_stamp_[x] == touch_now_ ? touch_state_[x] : graph_axis_[x]) != kUnknownAxis;
-    };
-    auto shares_verified = [&](const std::array<uint32_t, 3>& x, const std::array<uint32_t, 3>& y) {
-      for (uint32_t v : x)
-        if ((v == y[0] || v == y[1] || v == y[2]) && verified(v)) return true;
-      return false;
-    };
-    auto meets = [&](size_t i, const std::array<uint32_t, 3>& ids) {
-      return !shares_verified(changed_ids_[i], ids) &&
-             exact::faces_intersect(changed_pos_[i], changed_ids_[i], {pos_[ids[0]], pos_[ids[1]], pos_[ids[2]]}, ids);
-    };
-    // The changed triangles all hold keep: one graph fan covers every pair of them.
-    for (size_t i = 0; i < changed_.size() && keep_state == kUnknownAxis; ++i)
-      for (size_t j = i + 1; j < changed_.size(); ++j) {
-        if (shares_verified(changed_ids_[i], changed_ids_[j])) continue;
-        if (exact::faces_intersect(changed_pos_[i], changed_ids_[i], changed_pos_[j], changed_ids_[j])) {
-          ++rejected_intersection_;
-          return false;
-        }
-      }
     next_stamp_for_collapse(t1, t2);
     bool hit = false;
     if (guarded_) {

@@ -89,7 +89,7 @@ bool have(const char* program) {
 std::vector<fs::path> sample_recipes() {
   std::vector<fs::path> out;
   for (const auto& e : fs::directory_iterator(fs::path(LACUNA_SOURCE_DIR) / "samples"))
-    if (e.path().extension() == ".json") out.push_back(e.path());
+    if (e.path().extension() == ".json" && e.path().stem().extension() != ".expected") out.push_back(e.path());
   std::sort(out.begin(), out.end());
   return out;
 }
@@ -97,6 +97,48 @@ std::vector<fs::path> sample_recipes() {
 // --- every sample ------------------------------------------------------------------------------
 
 class Sample : public ::testing::TestWithParam<std::string> {};
+
+// Each sample's parts as they were when last pinned (samples/NAME.expected.json): a change that
+// alters a part is seen, not only one that breaks validity. Components and genus must match exactly,
+// volumes within 0.1 % (tetrahedra 1e-5 of the pinned volume), triangle and tetrahedron counts within
+// 1 %. LACUNA_PIN_SAMPLES=1 writes the file from this run instead (after a deliberate change).
+void check_pinned_expectations(const std::string& sample, const nlohmann::json& report) {
+  const fs::path pinned = fs::path(LACUNA_SOURCE_DIR) / "samples" / (sample + ".expected.json");
+  nlohmann::json now = nlohmann::json::object();
+  for (const auto& o : report["outputs"]) {
+    nlohmann::json e = {{"volume_mm3", o["volume_mm3"]}};
+    if (o.contains("tets")) {
+      e["tets"] = o["tets"];
+    } else {
+      e["triangles"] = o["triangles"];
+      e["components"] = o["components"];
+      e["genus"] = o["genus"];
+    }
+    now[fs::path(o["file"].get<std::string>()).filename().string()] = e;
+  }
+  const char* pin = std::getenv("LACUNA_PIN_SAMPLES");
+  if (pin && std::string(pin) == "1") {
+    std::ofstream(pinned) << nlohmann::json({{"outputs", now}}).dump(2) << "\n";
+    return;
+  }
+  ASSERT_TRUE(fs::exists(pinned)) << pinned << " is missing: run the sample test with LACUNA_PIN_SAMPLES=1 to write it";
+  const nlohmann::json expected = nlohmann::json::parse(read_file(pinned))["outputs"];
+  ASSERT_EQ(expected.size(), now.size()) << pinned << ": the sample writes other files than pinned";
+  for (const auto& [file, e] : expected.items()) {
+    ASSERT_TRUE(now.contains(file)) << pinned << ": " << file << " is no longer written";
+    const nlohmann::json& n = now[file];
+    const double v = e["volume_mm3"].get<double>();
+    if (e.contains("tets")) {
+      EXPECT_NEAR(n["volume_mm3"].get<double>(), v, 1e-5 * v) << file;
+      EXPECT_NEAR(n["tets"].get<double>(), e["tets"].get<double>(), 0.01 * e["tets"].get<double>()) << file;
+      continue;
+    }
+    EXPECT_NEAR(n["volume_mm3"].get<double>(), v, 1e-3 * v) << file;
+    EXPECT_EQ(n["components"], e["components"]) << file;
+    EXPECT_EQ(n["genus"], e["genus"]) << file;
+    EXPECT_NEAR(n["triangles"].get<double>(), e["triangles"].get<double>(), 0.01 * e["triangles"].get<double>()) << file;
+  }
+}
 
 TEST_P(Sample, RunsAndEveryOutputPassesTheChecks) {
   TempDir dir;
@@ -173,6 +215,7 @@ TEST_P(Sample, RunsAndEveryOutputPassesTheChecks) {
       }
     }
   }
+  check_pinned_expectations(GetParam(), report);
   if (!missing.empty()) {
     std::string names;
     for (const std::string& m : missing) names += (names.empty() ? "" : ", ") + m;
