@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# The libFuzzer targets (fuzz/: recipe parser, CIFS systems, STL/OBJ/PLY/3MF readers), built with
+# The libFuzzer targets (tests/fuzz/: recipe parser, CIFS systems, STL/OBJ/PLY/3MF readers), built with
 # Debian's clang in build-fuzz/ and run for SECONDS each (default 20), then every file of the
-# regression corpus tests/fuzz_corpus/ once. A crash leaves its input as build-fuzz/fuzz/<target>-crash-*:
+# regression corpus tests/fuzz_corpus/ once. A crash leaves its input as build-fuzz/tests/fuzz/<target>-crash-*:
 # copy it into tests/fuzz_corpus/<target>/ with the fix.
 #
 #   scripts/fuzz.sh [SECONDS]
