@@ -788,7 +788,15 @@ class RegionSimplifier {
     // the deviation of the new fan: plane distances alone miss a spike folded into its base.
     {
       // A triangle of the new fan the point is near (its id), or kNone.
-      auto near_new_fan = [&](const Vec3d& point) {
+      auto near_new_fan = [&](const Vec3d& point, uint32_t last) {
+        // The triangle it was last found near first, when it is one of the new fan's.
+        if (last != kNone && last != t1 && last != t2 && tri_alive_[last]) {
+          const auto& t = tri_[last];
+          if ((t[0] == keep || t[1] == keep || t[2] == keep || t[0] == drop || t[1] == drop || t[2] == drop) &&
+              within_deviation(point, at(rename(t[0]), keep, target), at(rename(t[1]), keep, target),
+                               at(rename(t[2]), keep, target)))
+            return last;
+        }
         for (uint32_t c : new_fan_)
           if (within_deviation(point, target, at(rename(to(c)), keep, target),
                                at(rename(from(prev_he(c))), keep, target)))
@@ -803,7 +811,7 @@ class RegionSimplifier {
       for (uint32_t v : {keep, drop})
         for (uint8_t i = 0; i < represented_count_[v]; ++i) removed_.push_back(represented_[v][i]);
       for (Represented& point : removed_)
-        if ((point.near = near_new_fan(point.at)) == kNone) return false;
+        if ((point.near = near_new_fan(point.at, point.near)) == kNone) return false;
       // The neighbours' fans change too (drop renamed, keep moved): the points they stand for stay
       // within the deviation of what remains of their fans.
       auto ring_keeps_points = [&](uint32_t r) {
@@ -849,7 +857,10 @@ class RegionSimplifier {
     // The new triangles stay near the old surface: each centroid, and the midpoint of every edge
     // from the new vertex, within the deviation of the old fans (vertex tests alone let a
     // triangle bridge a concave crease or a sliver).
-    auto near_old_surface = [&](const Vec3d& sample) {
+    // The sample's own triangle as it was is tried first: it is usually the one near.
+    auto near_old_surface = [&](const Vec3d& sample, uint32_t first) {
+      const auto& f = tri_[first];
+      if (within_deviation(sample, pos_[f[0]], pos_[f[1]], pos_[f[2]])) return true;
       for (const std::vector<uint32_t>* fan : {&keep_corners_, &drop_corners_})
         for (uint32_t c : *fan) {
           const auto& t = tri_[tri_of(c)];
@@ -858,9 +869,10 @@ class RegionSimplifier {
       return false;
     };
     for (size_t i = 0; i < changed_.size(); ++i)
-      if (!near_old_surface((changed_pos_[i][0] + changed_pos_[i][1] + changed_pos_[i][2]) / 3.0)) return false;
+      if (!near_old_surface((changed_pos_[i][0] + changed_pos_[i][1] + changed_pos_[i][2]) / 3.0, changed_[i]))
+        return false;
     for (uint32_t c : new_fan_)
-      if (!near_old_surface((target + pos_[rename(to(c))]) * 0.5)) return false;
+      if (!near_old_surface((target + pos_[rename(to(c))]) * 0.5, tri_of(c))) return false;
 
     next_stamp_for_collapse(t1, t2);
     bool hit = false;
