@@ -71,6 +71,12 @@ ObjectMesh mesh_volume(const Volume& volume, double simplify_mm, const std::stri
   const VolumeOptions& vopt = volume.options();
   detail::require_mesh_memory(volume, budget_of(max_memory_bytes), what, vopt);
   throw_if_cancelled(current_progress_sink());
+  ObjectMesh result = extract_object_surface(volume, simplify_mm);
+  if (result.mesh.triangles.empty()) throw InvalidInput(what + " is empty: nothing is left to mesh");
+  return result;
+}
+
+ObjectMesh extract_object_surface(const Volume& volume, double simplify_mm) {
   ObjectMesh result;
   result.voxels = volume.active_voxel_count();
   result.simplify_mm = simplify_mm;
@@ -87,7 +93,6 @@ ObjectMesh mesh_volume(const Volume& volume, double simplify_mm, const std::stri
   const double h = volume.voxel_size_mm();
   result.subvoxel_cavities_filled = fill_small_cavities(result.mesh, h * h * h);
   result.subvoxel_specks_removed = remove_small_specks(result.mesh, h * h * h);
-  if (result.mesh.triangles.empty()) throw InvalidInput(what + " is empty: nothing is left to mesh");
   return result;
 }
 

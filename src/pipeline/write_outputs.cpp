@@ -16,10 +16,9 @@
 #include "export/output_files.h"
 #include "pipeline/detail/memory.h"
 #include "pipeline/fea_output.h"
+#include "pipeline/mesh_object.h"
 #include "solids/check.h"
 #include "solids/components.h"
-#include "solids/extract.h"
-#include "solids/simplify.h"
 #include "solids/printability.h"
 #include "util/system.h"
 
@@ -169,49 +168,31 @@ RunReport write_outputs(const Recipe& recipe, const Plan& plan, Evaluation&& eva
       const uint64_t voxels = volume.active_voxel_count();
       // One surface per deviation the object's outputs ask for (usually one): the compact mesh is
       // extracted and simplified block by block, so the full marching-tetrahedra mesh never exists.
-      struct Surface {
-        TriMesh mesh;
-        uint64_t extracted_triangles = 0;
-        size_t filled = 0, specks = 0;
-      };
-      std::map<double, Surface> surfaces;
+      std::map<double, ObjectMesh> surfaces;
       for (const RecipeOutput& out : recipe.outputs) {
         const bool exports = out.object == object ||
                              std::find(out.group.begin(), out.group.end(), object) != out.group.end();
         const double deviation = simplify_deviation_mm(recipe, out);
         if (!exports || surfaces.count(deviation)) continue;
-        Surface& surface = surfaces[deviation];
-        if (deviation > 0) {
-          SimplifyOptions simplify;
-          simplify.max_deviation_mm = deviation;
-          SimplifyStats stats;
-          surface.mesh = extract_simplified_surface(volume, simplify, &stats);
-          surface.extracted_triangles = stats.input_triangles;
-        } else {
-          surface.mesh = extract_surface(volume);
-          surface.extracted_triangles = surface.mesh.triangles.size();
-        }
-        const double h = volume.voxel_size_mm();
-        surface.filled = fill_small_cavities(surface.mesh, h * h * h);
-        surface.specks = remove_small_specks(surface.mesh, h * h * h);
+        const ObjectMesh& surface = surfaces[deviation] = extract_object_surface(volume, deviation);
         if (surface.mesh.triangles.empty())
           throw InvalidInput(recipe.file + ": \"" + object + "\" is empty: nothing is left to export");
       }
       volume = Volume();
-      auto surface_for = [&](const RecipeOutput& out) -> const Surface& {
+      auto surface_for = [&](const RecipeOutput& out) -> const ObjectMesh& {
         return surfaces.at(simplify_deviation_mm(recipe, out));
       };
       // What every entry of this object's outputs shares: the mesh's figures, its printability, and
       // the hull volume of the output's object.
       auto entry_for = [&](const RecipeOutput& out, const std::string& final_path) {
-        const Surface& surface = surface_for(out);
+        const ObjectMesh& surface = surface_for(out);
         OutputReport entry;
         entry.file = final_path;
         entry.format = out.format;
         entry.object = out.object;
         entry.voxels = voxels;
-        entry.subvoxel_cavities_filled = surface.filled;
-        entry.subvoxel_specks_removed = surface.specks;
+        entry.subvoxel_cavities_filled = surface.subvoxel_cavities_filled;
+        entry.subvoxel_specks_removed = surface.subvoxel_specks_removed;
         entry.simplify_mm = simplify_deviation_mm(recipe, out);
         entry.extracted_triangles = surface.extracted_triangles;
         entry.printability = printability;
