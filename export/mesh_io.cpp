@@ -19,8 +19,10 @@
 
 namespace lacuna {
 
-// Defined in threemf.cpp; read_mesh has already checked that the file exists and is not empty.
+// Defined in threemf.cpp and draco.cpp; read_mesh has already checked that the file exists and is
+// not empty.
 TriMesh read_3mf(const std::string& path, const ReadOptions& options);
+TriMesh read_draco(const std::string& path, const ReadOptions& options);
 
 namespace {
 
@@ -956,10 +958,11 @@ MeshFormat mesh_format_from_path(const std::string& path) {
   if (extension == ".obj") return MeshFormat::kObj;
   if (extension == ".ply") return MeshFormat::kPly;
   if (extension == ".3mf") return MeshFormat::k3mf;
+  if (extension == ".drc") return MeshFormat::kDrc;
   fail(path,
        extension.empty()
-           ? "the file name has no extension (expected .stl, .obj, .ply or .3mf)"
-           : cat("unknown mesh format '", extension, "' (expected .stl, .obj, .ply or .3mf)"));
+           ? "the file name has no extension (expected .stl, .obj, .ply, .3mf or .drc)"
+           : cat("unknown mesh format '", extension, "' (expected .stl, .obj, .ply, .3mf or .drc)"));
 }
 
 const char* mesh_format_name(MeshFormat format) {
@@ -972,6 +975,8 @@ const char* mesh_format_name(MeshFormat format) {
       return "PLY";
     case MeshFormat::k3mf:
       return "3MF";
+    case MeshFormat::kDrc:
+      return "Draco";
   }
   return "unknown";
 }
@@ -985,6 +990,8 @@ TriMesh read_mesh(const std::string& path, MeshFormat format, const ReadOptions&
   TriMesh mesh;
   if (format == MeshFormat::k3mf) {
     mesh = read_3mf(path, options);
+  } else if (format == MeshFormat::kDrc) {
+    mesh = read_draco(path, options);
   } else {
     InputFile file(path);
     if (format == MeshFormat::kStl) mesh = read_stl(file, options);

@@ -1,6 +1,6 @@
-// Reading and writing triangle meshes: binary and ASCII STL, OBJ, PLY (ASCII and binary) and
-// 3MF. Readers validate everything and throw InvalidInput naming the file, the line or byte
-// offset, and what was expected; they never crash on malformed input.
+// Reading and writing triangle meshes: binary and ASCII STL, OBJ, PLY (ASCII and binary), 3MF
+// and Draco (export/draco.h). Readers validate everything and throw InvalidInput naming the file,
+// the line or byte offset, and what was expected; they never crash on malformed input.
 #pragma once
 
 #include <cstdint>
@@ -12,9 +12,9 @@
 
 namespace lacuna {
 
-enum class MeshFormat { kStl, kObj, kPly, k3mf };
+enum class MeshFormat { kStl, kObj, kPly, k3mf, kDrc };
 
-// The format named by the file's extension (case-insensitive .stl .obj .ply .3mf); throws
+// The format named by the file's extension (case-insensitive .stl .obj .ply .3mf .drc); throws
 // InvalidInput for any other extension.
 MeshFormat mesh_format_from_path(const std::string& path);
 const char* mesh_format_name(MeshFormat format);

@@ -4,9 +4,9 @@
 #
 #   scripts/setup.sh                      install and build
 #   scripts/setup.sh --run RECIPE [ARGS]  ... then `lacuna run RECIPE ARGS`
-#   scripts/setup.sh --test               ... with the test clients (PrusaSlicer, admesh, Gmsh, CalculiX, pytest,
-#                                         meshio) and clang (scripts/fuzz.sh), warnings as errors, then the
-#                                         whole test suite through CTest
+#   scripts/setup.sh --test               ... with the test clients (PrusaSlicer, admesh, Gmsh, CalculiX, Draco's
+#                                         reference decoder, pytest, meshio) and clang (scripts/fuzz.sh),
+#                                         warnings as errors, then the whole test suite through CTest
 #
 # The Python module is built for Debian's /usr/bin/python3 (where python3-numpy lives), whatever
 # python3 comes first on PATH; PYTHONPATH=build/python imports it from the build tree.
@@ -30,7 +30,7 @@ packages=(build-essential cmake ninja-build ccache pkg-config
           python3-dev pybind11-dev python3-numpy)
 if [ "$mode" = test ]; then
   # Real downstream clients the tests run the outputs through.
-  packages+=(prusa-slicer admesh gmsh calculix-ccx python3-pytest python3-meshio clang libclang-rt-14-dev)
+  packages+=(prusa-slicer admesh gmsh calculix-ccx draco python3-pytest python3-meshio clang libclang-rt-14-dev)
 fi
 
 missing=()

@@ -156,5 +156,32 @@ TEST(CifsSolids, OptionsMustFitThePrimitives) {
   EXPECT_THROW(cifs::attractor_geometry(cifs::library_system("menger_sponge"), 8, {}), ResourceLimit);
 }
 
+TEST(CifsSolids, LevelsWhosePiecesAreFarBelowAVoxelAreRefused) {
+  // The unit Sierpinski triangle's pieces at level L span 2^-L by 2^-L sqrt(3)/2: a box diagonal of
+  // 2^-L sqrt(7)/2. With 0.1 mm voxels the first level under an eighth of a voxel is 7 (0.0103 mm;
+  // level 6: 0.0207 mm); level 7 is accepted, level 8 and beyond refused, naming level 7.
+  const cifs::Cifs triangle = cifs::library_system("sierpinski_triangle");
+  cifs::SolidOptions edges;
+  edges.as = cifs::SolidOptions::As::kEdges;
+  edges.radius_mm = 0.1;
+  edges.voxel_size_mm = 0.1;
+  EXPECT_NO_THROW(cifs::attractor_geometry(triangle, 7, edges));
+  for (int level : {8, 14}) {
+    try {
+      cifs::attractor_geometry(triangle, level, edges);
+      ADD_FAILURE() << "level " << level << " was accepted";
+    } catch (const InvalidInput& e) {
+      const std::string diagonal = message_number(std::ldexp(std::sqrt(7.0) / 2, -level));
+      EXPECT_NE(std::string(e.what()).find(" " + diagonal + " mm"), std::string::npos) << diagonal << ": " << e.what();
+      EXPECT_NE(std::string(e.what()).find("use \"level\" 7 or less"), std::string::npos) << e.what();
+    }
+  }
+  // Finer voxels allow finer levels; without a voxel size nothing is refused for this reason.
+  edges.voxel_size_mm = 0.01;
+  EXPECT_NO_THROW(cifs::attractor_geometry(triangle, 10, edges));
+  edges.voxel_size_mm = 0;
+  EXPECT_NO_THROW(cifs::attractor_geometry(triangle, 14, edges));
+}
+
 }  // namespace
 }  // namespace lacuna

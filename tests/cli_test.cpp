@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fill/fill.h"
+#include "tests/test_support.h"
 #include <regex>
 #include <set>
 #include <sstream>
@@ -24,67 +25,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-  int code = -1;
-  std::string out, err;
-  double seconds = 0;
-};
-
-std::string read_file(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void write_file(const fs::path& p, const std::string& text) {
-  std::ofstream out(p, std::ios::binary);
-  out << text;
-}
-
-// A fresh folder per test, removed afterwards.
-class TempDir {
- public:
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    std::string name = "lacuna-" + std::string(info->test_suite_name()) + "-" + info->name() + "-" +
-                       std::to_string(::getpid());
-    std::replace(name.begin(), name.end(), '/', '_');
-    path_ = fs::temp_directory_path() / name;
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() { fs::remove_all(path_); }
-  const fs::path& path() const { return path_; }
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-
- private:
-  fs::path path_;
-};
-
-std::string quote(const std::string& s) { return "'" + s + "'"; }
-
-Result run(const std::string& command, const fs::path& scratch) {
-  Result r;
-  fs::path out = scratch / ".stdout", err = scratch / ".stderr";
-  std::string line = command + " > " + quote(out.string()) + " 2> " + quote(err.string());
-  auto start = std::chrono::steady_clock::now();
-  int status = std::system(line.c_str());
-  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = read_file(out);
-  r.err = read_file(err);
-  fs::remove(out);
-  fs::remove(err);
-  return r;
-}
-
-Result lacuna(const std::string& args, const fs::path& scratch) { return run(quote(LACUNA_BINARY) + " " + args, scratch); }
-
-bool have(const char* program) {
-  std::string cmd = std::string("command -v ") + program + " > /dev/null 2>&1";
-  return std::system(cmd.c_str()) == 0;
-}
+using test::have;
+using test::lacuna;
+using test::quote;
+using test::read_file;
+using test::run;
+using test::Result;
+using test::TempDir;
+using test::write_file;
 
 std::vector<fs::path> sample_recipes() {
   std::vector<fs::path> out;
@@ -481,7 +429,7 @@ std::vector<BadCase> bad_cases() {
       {"empty_outputs", R"({"inputs": {"x": )" + ok_input + R"(}, "outputs": []})", "", "", "non-empty list"},
       {"output_of_unknown", R"({"inputs": {"ball": )" + ok_input + R"(}, "outputs": [{"of": "bal", "file": "x.stl"}]})", "", "", "did you mean \"ball\""},
       {"output_with_folder", R"({"inputs": {"x": )" + ok_input + R"(}, "outputs": [{"of": "x", "file": "../x.stl"}]})", "", "", "plain file name"},
-      {"output_bad_extension", R"({"inputs": {"x": )" + ok_input + R"(}, "outputs": [{"of": "x", "file": "x.obj"}]})", "", "", ".stl or .3mf"},
+      {"output_bad_extension", R"({"inputs": {"x": )" + ok_input + R"(}, "outputs": [{"of": "x", "file": "x.obj"}]})", "", "", ".stl, .3mf or .drc"},
       {"output_twice", R"({"inputs": {"x": )" + ok_input + R"(}, "outputs": [{"of": "x", "file": "x.stl"}, {"of": "x", "file": "x.stl"}]})", "", "", "written twice"},
       {"operation_unknown_operand", R"({"inputs": {"x": )" + ok_input + R"(}, "operations": [{"name": "u", "op": "union", "of": ["x", "y"]}], "outputs": [{"of": "u", "file": "x.stl"}]})", "", "", "operations[0].of"},
       {"operation_forward_reference", R"({"inputs": {"x": )" + ok_input + R"(}, "operations": [{"name": "u", "op": "union", "of": ["x", "v"]}, {"name": "v", "op": "offset", "of": "x", "distance_mm": 1}], "outputs": [{"of": "u", "file": "x.stl"}]})", "", "", "earlier operation"},

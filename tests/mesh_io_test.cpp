@@ -603,7 +603,7 @@ TEST_F(MeshIoTest, MalformedFilesThrowInvalidInputNamingTheProblem) {
        "not a readable 3MF package"},
       {"deep.3mf", package_3mf(model_xml("millimeter", deep_3mf)),
        "components nest more than 32 levels deep"},
-      {"part.xyz", "0 0 0\n", "unknown mesh format '.xyz' (expected .stl, .obj, .ply or .3mf)"},
+      {"part.xyz", "0 0 0\n", "unknown mesh format '.xyz' (expected .stl, .obj, .ply, .3mf or .drc)"},
       {"no_extension", "solid\n", "the file name has no extension"},
   };
   ASSERT_GE(cases.size(), 20u);

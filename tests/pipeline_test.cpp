@@ -17,26 +17,15 @@
 
 #include "errors.h"
 #include "pipeline/pipeline.h"
+#include "tests/test_support.h"
 
 namespace lacuna {
 namespace {
 
 namespace fs = std::filesystem;
 
-class TempDir {
- public:
-  TempDir() : path_(fs::temp_directory_path() / ("lacuna_pipeline_" + std::to_string(::getpid()) + "_" +
-                                                 std::to_string(counter_++))) {
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() { fs::remove_all(path_); }
-  const fs::path& path() const { return path_; }
-
- private:
-  static inline int counter_ = 0;
-  fs::path path_;
-};
+using test::read_file;
+using test::TempDir;
 
 // Records the stages it is told about; asks to stop once `cancel_after` stages have begun (0: never).
 class RecordingSink : public ProgressSink {
@@ -65,12 +54,6 @@ const char* kBallRecipe = R"({
   "outputs": [{"of": "ball", "file": "ball.stl"}]
 })";
 
-std::string read_file(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 TEST(Pipeline, PlanNeedsWhatTheOutputsReadAndCountsEachRead) {
   const Recipe recipe = parse_recipe(R"({

@@ -25,67 +25,20 @@
 #include "export/output_files.h"
 #include "geometry.h"
 #include "solids/region.h"
+#include "tests/test_support.h"
 
 namespace lacuna {
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-  int code = -1;
-  std::string out, err;
-  double seconds = 0;
-};
-
-std::string read_file(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void write_file(const fs::path& p, const std::string& text) {
-  std::ofstream out(p, std::ios::binary);
-  out << text;
-}
-
-class TempDir {
- public:
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    std::string name = "lacuna-" + std::string(info->test_suite_name()) + "-" + info->name() + "-" +
-                       std::to_string(::getpid());
-    std::replace(name.begin(), name.end(), '/', '_');
-    path_ = fs::temp_directory_path() / name;
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() { fs::remove_all(path_); }
-  const fs::path& path() const { return path_; }
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-
- private:
-  fs::path path_;
-};
-
-std::string quote(const std::string& s) { return "'" + s + "'"; }
-
-Result run(const std::string& command, const fs::path& scratch) {
-  Result r;
-  const fs::path out = scratch / ".stdout", err = scratch / ".stderr";
-  const std::string line = command + " > " + quote(out.string()) + " 2> " + quote(err.string());
-  const auto start = std::chrono::steady_clock::now();
-  const int status = std::system(line.c_str());
-  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = read_file(out);
-  r.err = read_file(err);
-  fs::remove(out);
-  fs::remove(err);
-  return r;
-}
-
-Result lacuna(const std::string& args, const fs::path& scratch) { return run(quote(LACUNA_BINARY) + " " + args, scratch); }
+using test::lacuna;
+using test::quote;
+using test::read_file;
+using test::run;
+using test::Result;
+using test::TempDir;
+using test::write_file;
 
 // Every entry of a folder, hidden ones included.
 std::vector<std::string> entries(const fs::path& dir) {
@@ -176,6 +129,9 @@ std::vector<HostileCase> hostile_cases() {
       {"offset_deeper_than_the_part", R"({"inputs": {"s": {"type": "sphere", "radius_mm": 1}},
           "operations": [{"name": "o", "op": "offset", "of": "s", "distance_mm": -1e9}],
           "outputs": [{"of": "o", "file": "o.stl"}]})", 2, "leaves nothing of \"s\""},
+      {"cifs_pieces_far_below_a_voxel", R"({"inputs": {"c": {"type": "cifs", "system": "sierpinski_triangle",
+          "level": 14, "as": "edges", "radius_mm": 0.1}}, "outputs": [{"of": "c", "file": "c.stl"}]})", 2,
+       "change no voxel"},
       {"cifs_pieces_beyond_the_stream_bound", R"({"inputs": {"c": {"type": "cifs", "system": "koch_curve", "level": 14,
           "as": "edges", "radius_mm": 0.01}}, "outputs": [{"of": "c", "file": "c.stl"}]})", 3, "more than 20000000"},
   };

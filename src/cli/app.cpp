@@ -229,7 +229,7 @@ void handle_interruptions() {
 int run_app(int argc, char** argv) {
   handle_interruptions();
   CLI::App app{"Lacuna: volumetric solid modeling for additive manufacturing.\n"
-               "Runs recipe files (JSON) into checked, printable STL and 3MF parts.\n"
+               "Runs recipe files (JSON) into checked, printable STL, 3MF and Draco parts.\n"
                "Exit codes: 0 success, 2 bad usage or input, 3 resource limit, 4 failed validity check."};
   app.set_version_flag("--version", "lacuna " LACUNA_VERSION);
   app.require_subcommand(1);
@@ -253,7 +253,7 @@ int run_app(int argc, char** argv) {
 
   std::string mesh_path;
   CLI::App* check = app.add_subcommand(
-      "check", "Check a mesh (STL, 3MF, OBJ, PLY) as a printable solid: closed, manifold, outward-oriented,\n"
+      "check", "Check a mesh (STL, 3MF, OBJ, PLY, Draco) as a printable solid: closed, manifold, outward-oriented,\n"
                "free of self-intersections and degenerate faces, positive volume. Exit 0 only if valid.");
   check->add_option("MESH", mesh_path, "Mesh file")->required();
   PrintArgs print;
@@ -271,7 +271,7 @@ int run_app(int argc, char** argv) {
   FeaArgs fea_args;
   CLI::App* fea = app.add_subcommand(
       "fea", "Tetrahedral mesh for finite elements (TetGen) of a recipe's first output or of a mesh file");
-  fea->add_option("INPUT", fea_args.input, "Recipe (.json) or closed mesh (.stl .obj .ply .3mf)")->required();
+  fea->add_option("INPUT", fea_args.input, "Recipe (.json) or closed mesh (.stl .obj .ply .3mf .drc)")->required();
   fea->add_option("-o,--output", fea_args.output, "Output file: .inp (Abaqus/CalculiX), .msh (Gmsh), .vtu, .mesh (Medit)")
       ->required();
   fea->add_option("--format", fea_args.format, "inp, msh, vtu or mesh (must match the output's extension)")

@@ -233,7 +233,9 @@ class Builder {
   void add(const CifsInput& c) {
     auto attractor = [&](const cifs::Cifs& placed) {
       try {
-        return cifs::attractor_geometry(placed, c.level, c.solid);
+        cifs::SolidOptions solid = c.solid;
+        solid.voxel_size_mm = vopt_.voxel_size_mm;
+        return cifs::attractor_geometry(placed, c.level, solid);
       } catch (const InvalidInput& e) {
         throw InvalidInput(where() + ": " + e.what());
       } catch (const ResourceLimit& e) {

@@ -1,5 +1,6 @@
 #include "pipeline/report.h"
 
+#include <algorithm>
 #include <nlohmann/json.hpp>
 
 #include "export/report.h"
@@ -120,8 +121,18 @@ nlohmann::json to_json(const OutputReport& out) {
   entry["subvoxel_specks_removed"] = out.subvoxel_specks_removed;
   entry["simplify_mm"] = out.simplify_mm;
   entry["extracted_triangles"] = out.extracted_triangles;
+  if (out.draco) entry["draco"] = to_json(*out.draco);
   annotate(entry, out);
   return entry;
+}
+
+nlohmann::json to_json(const DracoFigures& d) {
+  return {{"quantization_bits", d.quantization_bits},
+          {"max_move_mm", d.max_move_mm},
+          {"file_bytes", d.file_bytes},
+          {"binary_stl_bytes", d.binary_stl_bytes},
+          {"compression_vs_binary_stl", double(d.binary_stl_bytes) / double(std::max<uint64_t>(d.file_bytes, 1))},
+          {"refinements", d.refinements}};
 }
 
 nlohmann::json to_json(const RunReport& report) {

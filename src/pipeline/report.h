@@ -10,6 +10,7 @@
 #include <variant>
 #include <vector>
 
+#include "pipeline/draco_output.h"
 #include "pipeline/fea_output.h"
 #include "solids/check.h"
 #include "solids/printability.h"
@@ -111,6 +112,7 @@ struct OutputReport {
   double simplify_mm = 0;             // deviation the surface was simplified to (mm; 0: not simplified)
   uint64_t extracted_triangles = 0;   // of the surface before simplification
   std::optional<MeshCheckReport> check;  // surface outputs: the file as read back
+  std::optional<DracoFigures> draco;     // .drc outputs: quantization and size
   std::optional<TetCheck> tetrahedra;    // tetrahedral outputs
   std::optional<PrintabilityFindings> printability;
   std::optional<double> hull_volume_mm3;  // infill objects: the hull's volume, for the relative density
@@ -143,6 +145,9 @@ nlohmann::json to_json(const InputReport& report);
 
 // An output's entry in report.json.
 nlohmann::json to_json(const OutputReport& report);
+
+// A .drc output's figures: quantization bits, the bound on vertex moves, sizes and their ratio.
+nlohmann::json to_json(const DracoFigures& figures);
 
 // report.json: the run's figures, every output's entry, the inputs' reports; a stage that ran more
 // than once is given its last time, total_seconds sums them all.

@@ -15,6 +15,7 @@
 #include "export/mesh_io.h"
 #include "export/output_files.h"
 #include "pipeline/detail/memory.h"
+#include "pipeline/draco_output.h"
 #include "pipeline/fea_output.h"
 #include "pipeline/mesh_object.h"
 #include "solids/check.h"
@@ -225,6 +226,18 @@ RunReport write_outputs(const Recipe& recipe, const Plan& plan, Evaluation&& eva
         if (out.object != object) continue;
         std::string final_path = (out_dir / out.file).string();
         const TriMesh& surface = surface_for(out).mesh;
+        if (out.format == "drc") {
+          // Written, decoded from the file and checked here: a failing check refines the grid.
+          timer.start("write");
+          const DracoOutput drc = write_checked_draco(transaction.stage(final_path), surface,
+                                                      out.quantize_mm.value_or(vopt.voxel_size_mm / 10), budget);
+          OutputReport entry = entry_for(out, final_path);
+          entry.check = drc.check;
+          entry.draco = drc.figures;
+          entry.part_name = out.part_name;
+          report.outputs.push_back(std::move(entry));
+          continue;
+        }
         if (out.format == "stl" || out.format == "3mf") {
           timer.start("write");
           std::string temp = transaction.stage(final_path);

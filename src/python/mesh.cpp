@@ -9,6 +9,8 @@
 #include "export/output_files.h"
 #include "export/report.h"
 #include "pipeline/check_file.h"
+#include "pipeline/draco_output.h"
+#include "pipeline/report.h"
 #include "pipeline/fea_output.h"
 #include "pipeline/mesh_object.h"
 #include "python/convert.h"
@@ -52,6 +54,39 @@ FeaSettings fea_settings(const std::string& file, const py::dict& options) {
   return parse_recipe(recipe.dump(), "Mesh.save").outputs.front().fea;
 }
 
+// A Draco file within quantize_mm (default: a tenth of the voxel the mesh was made on), decoded from
+// the file and checked; its figures and check as a dict.
+py::object save_draco(const Mesh& mesh, const std::string& path, const py::dict& keys) {
+  double quantize_mm = 0;
+  for (const auto& [key, value] : keys) {
+    if (py::str(key).cast<std::string>() != "quantize_mm")
+      throw py::value_error("Mesh.save: a .drc file takes quantize_mm only, not " + py::str(key).cast<std::string>());
+    quantize_mm = value.cast<double>();
+    if (!(quantize_mm > 0) || !std::isfinite(quantize_mm))
+      throw py::value_error("Mesh.save: quantize_mm: expected a positive length in mm");
+  }
+  if (quantize_mm == 0) {
+    if (!(mesh.voxel_size_mm > 0))
+      throw py::value_error("Mesh.save: give quantize_mm (mm) for a .drc file of a mesh that was not meshed from a "
+                            "voxel grid (Solid.mesh and Grid.mesh meshes use a tenth of their voxel)");
+    quantize_mm = mesh.voxel_size_mm / 10;
+  }
+  const DracoOutput out = released([&] {
+    OutputTransaction transaction;
+    DracoOutput d = write_checked_draco(transaction.stage(path), *mesh.data, quantize_mm, uint64_t{8} << 30);
+    if (d.check.valid()) transaction.commit();
+    return d;
+  });
+  nlohmann::json report = check_report_json(out.check);
+  report["file"] = path;
+  report["draco"] = to_json(out.figures);
+  if (!out.check.valid()) {
+    std::string message = path + ": no Draco quantization keeps the mesh valid; nothing was written";
+    raise(errors().check_failed, message, from_json(report));
+  }
+  return from_json(report);
+}
+
 py::object save(const Mesh& mesh, const std::string& path, const std::string& name, const py::dict& fea) {
   std::string ext = fs::path(path).extension().string();
   for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
@@ -73,9 +108,10 @@ py::object save(const Mesh& mesh, const std::string& path, const std::string& na
     });
     return py::none();
   }
+  if (ext == ".drc") return save_draco(mesh, path, fea);
   if (ext != ".msh" && ext != ".inp" && ext != ".vtu" && ext != ".mesh")
-    throw InvalidInput(path +
-                       ": expected a file name ending in .stl or .3mf (or .msh, .inp, .vtu, .mesh for tetrahedra)");
+    throw InvalidInput(path + ": expected a file name ending in .stl, .3mf or .drc (or .msh, .inp, .vtu, .mesh for "
+                              "tetrahedra)");
   const FeaSettings settings = fea_settings(fs::path(path).filename().string(), fea);
   const TetCheck check = released([&] { return write_tetrahedra(*mesh.data, path, settings); });
   nlohmann::json report = fea_report_json(check);
@@ -139,10 +175,11 @@ const MeshCheckReport& Mesh::figures() const {
   return *summary;
 }
 
-Mesh make_mesh(TriMesh&& mesh, std::string label) {
+Mesh make_mesh(TriMesh&& mesh, std::string label, double voxel_size_mm) {
   Mesh m;
   m.data = std::make_shared<const TriMesh>(std::move(mesh));
   m.label = std::move(label);
+  m.voxel_size_mm = voxel_size_mm;
   return m;
 }
 
@@ -209,7 +246,9 @@ void add_mesh(py::module_& m) {
             return save(self, path_of(path), name, fea);
           },
           py::arg("path"), py::arg("name") = "",
-          "Writes the mesh: .stl (binary), .3mf (one object called `name`, default the file's stem), or tetrahedra "
+          "Writes the mesh: .stl (binary), .3mf (one object called `name`, default the file's stem), .drc (Draco, "
+          "no vertex moved further than the keyword quantize_mm, default a tenth of the voxel it was meshed on; "
+          "decoded again and checked; returns the check and the compression), or tetrahedra "
           "(TetGen) in .msh, .inp, .vtu or .mesh with the keys of a recipe output's \"fea\" object as keyword "
           "arguments (max_tet_volume_mm3, quality, min_dihedral_deg, preserve_surface, msh_version, element, "
           "time_limit_s); the surface must pass every check. Written through a temporary file: all or nothing. "
@@ -274,7 +313,7 @@ void add_mesh(py::module_& m) {
             const double deviation = deviation_mm(simplify_mm, g.volume.voxel_size_mm());
             const uint64_t budget = budget_bytes(max_memory_gb);
             ObjectMesh r = released([&] { return mesh_volume(g.volume, deviation, g.label, budget); });
-            return make_mesh(std::move(r.mesh), g.label);
+            return make_mesh(std::move(r.mesh), g.label, g.volume.voxel_size_mm());
           },
           py::arg("simplify_mm") = py::none(), py::arg("max_memory_gb") = py::none(),
           "Its surface (marching tetrahedra: closed, manifold, outward, free of self-intersections), simplified "

@@ -21,6 +21,7 @@ namespace py = pybind11;
 struct Mesh {
   std::shared_ptr<const TriMesh> data;
   std::string label = "mesh";  // the file it was read from, or what made it, for reports
+  double voxel_size_mm = 0;    // of the grid it was meshed from (0: not meshed here)
   // Figures from the checks without the self-intersection test, computed once when first asked for.
   mutable std::shared_ptr<const MeshCheckReport> summary;
 
@@ -34,7 +35,7 @@ struct Grid {
 };
 
 // A mesh taken over without copying.
-Mesh make_mesh(TriMesh&& mesh, std::string label);
+Mesh make_mesh(TriMesh&& mesh, std::string label, double voxel_size_mm = 0);
 
 // A mesh copied from an N x 3 array of positions and an M x 3 array of indices; throws ValueError
 // for other shapes and for indices out of range.

@@ -469,7 +469,7 @@ void add_solids(py::module_& m) {
             const ObjectOptions options = object_options(py::none(), max_memory_gb, threads);
             const std::string object = s.node->name;
             ObjectMesh r = released([&] { return mesh_object(recipe, object, options); });
-            return make_mesh(std::move(r.mesh), object);
+            return make_mesh(std::move(r.mesh), object, recipe.voxel_size_mm);
           },
           py::arg("voxel_size_mm") = 0.1, py::arg("simplify_mm") = py::none(), py::arg("band_voxels") = 3.0,
           py::arg("seed") = 0, py::arg("max_memory_gb") = py::none(), py::arg("threads") = py::none(),

@@ -294,7 +294,7 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
   std::set<std::string> files;
   for (size_t i = 0; i < outs.size(); ++i) {
     JsonObject o(outs[i], path, "outputs[" + std::to_string(i) + "]");
-    o.allow_only({"of", "file", "name", "simplify_mm", "decimate_mm", "fea"});
+    o.allow_only({"of", "file", "name", "simplify_mm", "decimate_mm", "fea", "quantize_mm"});
     RecipeOutput out;
     out.json_path = o.path();
     auto known = [&](const std::string& name) {
@@ -323,11 +323,11 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
       o.fail("file", "expected a plain file name such as \"part.stl\" (outputs go to the output folder): no '/', '\\', "
                      "control characters or leading '.', at most 200 characters");
     std::string ext = lower(fs::path(out.file).extension().string());
-    const std::map<std::string, std::string> formats = {{".stl", "stl"}, {".3mf", "3mf"}, {".msh", "msh"},
+    const std::map<std::string, std::string> formats = {{".stl", "stl"}, {".3mf", "3mf"}, {".drc", "drc"}, {".msh", "msh"},
                                                         {".inp", "inp"}, {".vtu", "vtu"}, {".mesh", "mesh"}};
     auto format = formats.find(ext);
     if (format == formats.end())
-      o.fail("file", "expected a file name ending in .stl or .3mf (or .msh, .inp, .vtu, .mesh for tetrahedra), got \"" +
+      o.fail("file", "expected a file name ending in .stl, .3mf or .drc (or .msh, .inp, .vtu, .mesh for tetrahedra), got \"" +
                          out.file + "\"");
     out.format = format->second;
     if (!out.group.empty() && out.format != "3mf")
@@ -339,7 +339,11 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
       o.fail("decimate_mm", "give \"simplify_mm\" only (\"decimate_mm\" is its older name)");
     if (o.has("simplify_mm")) out.simplify_mm = deviation(o, "simplify_mm");
     if (o.has("decimate_mm")) out.simplify_mm = deviation(o, "decimate_mm");
-    const bool tetrahedral = out.format != "stl" && out.format != "3mf";
+    const bool tetrahedral = out.format != "stl" && out.format != "3mf" && out.format != "drc";
+    if (o.has("quantize_mm")) {
+      if (out.format != "drc") o.fail("quantize_mm", "only a .drc output is quantized");
+      out.quantize_mm = o.positive_length_or("quantize_mm", 0.0);
+    }
     if (o.has("fea")) {
       if (!tetrahedral) o.fail("fea", "tetrahedral settings need a .msh, .inp, .vtu or .mesh file");
       JsonObject f = o.object("fea");

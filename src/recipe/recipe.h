@@ -91,11 +91,13 @@ struct RecipeOutput {
   // operation; empty for a single object.
   std::vector<std::string> group;
   std::string file;       // a plain file name inside the output folder
-  std::string format;     // "stl", "3mf", or a tetrahedral format "msh", "inp", "vtu", "mesh"
+  std::string format;     // "stl", "3mf", "drc", or a tetrahedral format "msh", "inp", "vtu", "mesh"
   std::string part_name;  // object name inside the file (3MF)
   // Deviation of this output's compact mesh (mm; 0: the plain marching-tetrahedra surface);
   // unset: the recipe's. `decimate_mm` is its older name.
   std::optional<double> simplify_mm;
+  // .drc: the most any vertex may move by quantization (mm); unset: a tenth of the voxel size.
+  std::optional<double> quantize_mm;
   FeaSettings fea;        // for tetrahedral formats
   std::string json_path;
 };

@@ -75,3 +75,58 @@ def test_calls_release_the_gil():
     during = [t for t in ticks if start < t < end]
     # Python ran on the other thread during the calls (a held GIL would allow no tick until each call returned).
     assert len(during) > 0.05 * (end - start) / 0.001
+
+
+# A script that runs the heavy recipe into argv[1]; SIGTERM raises KeyboardInterrupt there (Python's own
+# default_int_handler) when argv[2] is "handled", and keeps Python's default (the process dies) otherwise.
+SIGTERM_SCRIPT = """
+import signal, sys
+import lacuna
+if sys.argv[2] == "handled":
+    signal.signal(signal.SIGTERM, signal.default_int_handler)
+parts = [lacuna.sphere(center_mm=[10 * i, 0, 0], radius_mm=4) for i in range(4)]
+recipe = (parts[0] | parts[1] | parts[2] | parts[3]).to_recipe(name="heavy", voxel_size_mm=0.03)
+print("started", flush=True)
+try:
+    lacuna.run(recipe, output_dir=sys.argv[1])
+except KeyboardInterrupt:
+    sys.exit(143)
+sys.exit(0)
+"""
+
+
+def run_and_terminate(tmp_path, mode, after_s):
+    import subprocess
+    import sys
+
+    script = tmp_path / "term.py"
+    script.write_text(SIGTERM_SCRIPT)
+    child = subprocess.Popen([sys.executable, str(script), str(tmp_path / "out"), mode], stdout=subprocess.PIPE, text=True)
+    assert child.stdout.readline().strip() == "started"
+    time.sleep(after_s)
+    start = time.monotonic()
+    child.send_signal(signal.SIGTERM)
+    code = child.wait(timeout=60)
+    return code, time.monotonic() - start
+
+
+def test_sigterm_with_pythons_interrupt_handler_cancels_and_leaves_nothing(tmp_path):
+    code, seconds = run_and_terminate(tmp_path, "handled", 1.5)
+    assert code == 143
+    assert seconds < 5.0  # the run itself takes about 20 s
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_run_after_one_killed_by_sigterm_removes_its_leftovers(tmp_path):
+    # Python's default SIGTERM ends the process at once; whatever it left is a dead process's.
+    code, _ = run_and_terminate(tmp_path, "default", 1.5)
+    assert code == -signal.SIGTERM
+    out = tmp_path / "out"
+    out.mkdir(exist_ok=True)
+    import subprocess
+
+    dead = subprocess.Popen(["true"])
+    dead.wait()
+    (out / f".s.stl.tmp-{dead.pid}-0").write_text("partial")
+    lacuna.run(lacuna.sphere(radius_mm=1).to_recipe(name="s", voxel_size_mm=0.2), output_dir=out)
+    assert sorted(p.name for p in out.iterdir()) == ["report.json", "s.stl"]

@@ -69,6 +69,29 @@ def test_save_and_read_back(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["t.3mf", "t.stl"]
 
 
+def test_save_draco_within_a_tenth_of_the_voxel(tmp_path):
+    m = lacuna.torus(major_radius_mm=3, minor_radius_mm=1).mesh(voxel_size_mm=0.25)
+    report = m.save(tmp_path / "t.drc")
+    draco = report["draco"]
+    assert report["checks"]["valid"] and draco["max_move_mm"] <= 0.025
+    assert draco["file_bytes"] == (tmp_path / "t.drc").stat().st_size
+    assert draco["binary_stl_bytes"] == 84 + 50 * len(m.faces)
+    back = lacuna.read_mesh(tmp_path / "t.drc")
+    assert back.faces.shape == m.faces.shape and back.genus == 1
+    assert back.volume_mm3 == pytest.approx(m.volume_mm3, rel=1e-3)
+    # Every decoded vertex lies within the bound of one of the mesh's vertices.
+    d = np.linalg.norm(back.vertices[:, None, :] - m.vertices[None, :, :], axis=2).min(axis=1)
+    assert d.max() <= draco["max_move_mm"]
+    # A mesh made from arrays has no voxel: the bound must be given.
+    v, f = cube()
+    with pytest.raises(ValueError, match="quantize_mm"):
+        lacuna.Mesh(v, f).save(tmp_path / "c.drc")
+    assert lacuna.Mesh(v, f).save(tmp_path / "c.drc", quantize_mm=0.001)["checks"]["valid"]
+    with pytest.raises(ValueError, match="quantize_mm only"):
+        m.save(tmp_path / "x.drc", quality=2.0)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["c.drc", "t.drc"]
+
+
 def test_check_is_the_command_line_report(tmp_path, cli):
     m = lacuna.sphere(radius_mm=2).mesh(voxel_size_mm=0.2)
     path = tmp_path / "ball.stl"

@@ -88,8 +88,10 @@ class Mesh:
         msh_version: Literal["4.1", "2.2"] = ...,
         element: Literal["C3D4", "C3D10"] = ...,
         time_limit_s: float = ...,
+        quantize_mm: float = ...,
     ) -> Optional[Dict[str, Any]]:
-        """Writes .stl, .3mf, or tetrahedra (.msh, .inp, .vtu, .mesh; returns their report). All or nothing."""
+        """Writes .stl, .3mf, .drc (Draco within quantize_mm; returns its check and compression), or tetrahedra
+        (.msh, .inp, .vtu, .mesh; returns their report). All or nothing."""
     def simplify(self, max_deviation_mm: float) -> "Mesh":
         """A copy simplified with every collapse guarded, within max_deviation_mm (mm)."""
 
