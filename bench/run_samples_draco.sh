@@ -15,8 +15,8 @@ if [ "${#samples[@]}" -eq 0 ]; then
 fi
 out="$(mktemp -d)"
 trap 'rm -rf "$out"' EXIT
-echo "| sample | file | triangles | binary STL | .drc | ratio | bits | max move (mm) | voxel (mm) |"
-echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"
+echo "| sample | file | triangles | binary STL | .drc | ratio | bits | refinements | max move (mm) | voxel (mm) |"
+echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
 for s in "${samples[@]}"; do
   /usr/bin/python3 - "samples/$s.json" "$out/$s.json" <<'PY'
 import json, os, sys
@@ -36,7 +36,7 @@ json.dump(recipe, open(target, "w"))
 PY
   cp "$out/$s.json" "samples/.draco-bench-$s.json"
   "$build/lacuna" run "samples/.draco-bench-$s.json" -o "$out/$s" --quiet --json > "$out/$s-report.json" || {
-    rm -f "samples/.draco-bench-$s.json"; echo "| $s | failed | | | | | | | |"; continue; }
+    rm -f "samples/.draco-bench-$s.json"; echo "| $s | failed | | | | | | | | |"; continue; }
   rm -f "samples/.draco-bench-$s.json"
   /usr/bin/python3 - "$out/$s-report.json" "$s" <<'PY'
 import json, os, sys
@@ -46,13 +46,13 @@ for o in report["outputs"]:
     if not d:
         continue
     print(f"| {sys.argv[2]} | {os.path.basename(o['file'])} | {o['triangles']:,} | {d['binary_stl_bytes']/1e6:.2f} MB | "
-          f"{d['file_bytes']/1e6:.3f} MB | {d['compression_vs_binary_stl']:.1f} | {d['quantization_bits']} | "
-          f"{d['max_move_mm']:.4f} | {report['voxel_size_mm']:g} |".replace(",", " "))
+          f"{d['file_bytes']/1e6:.3f} MB | {d['compression_vs_binary_stl']:.1f} | {d['quantization_bits']} | {d['refinements']} | "
+          f"{d['max_move_mm']:.5f} | {report['voxel_size_mm']:g} |".replace(",", " "))
 PY
 done | tee "$out/table.md"
 /usr/bin/python3 - "$out/table.md" <<'PY'
 import sys
-ratios = [float(line.split("|")[6]) for line in open(sys.argv[1]) if line.count("|") > 8 and "failed" not in line]
+ratios = [float(line.split("|")[6]) for line in open(sys.argv[1]) if line.count("|") > 9 and "failed" not in line]
 if ratios:
     print(f"\nsmallest ratio {min(ratios):.1f}, median {sorted(ratios)[len(ratios)//2]:.1f} over {len(ratios)} files")
 PY

@@ -29,6 +29,7 @@
 #include "export/output_files.h"
 #include "export/report.h"
 #include "pipeline/pipeline.h"
+#include "pipeline/render_output.h"
 #include "util/progress.h"
 #include "util/system.h"
 
@@ -126,6 +127,46 @@ int command_check(const std::string& path, const CommonFlags& flags, const Print
     }
   }
   return result.valid() ? kExitOk : kExitCheckFailed;
+}
+
+struct RenderArgs {
+  std::string input, output, views = "iso", size = "1200x900", object;
+  PrintArgs print;
+};
+
+// `lacuna render`: a mesh file or a recipe's object as a PNG picture.
+int command_render(const RenderArgs& args, const RunOptions& base, const CommonFlags& flags) {
+  RenderFileOptions options;
+  options.run = base;
+  options.object = args.object;
+  options.picture.views.clear();
+  std::stringstream views(args.views);
+  for (std::string v; std::getline(views, v, ',');) options.picture.views.push_back(render_view_from_name(v, "--views"));
+  if (options.picture.views.empty()) throw InvalidInput("--views: expected one or more of iso, front, top, side");
+  int w = 0, h = 0;
+  char x = 0, rest = 0;
+  if (std::sscanf(args.size.c_str(), "%d%c%d%c", &w, &x, &h, &rest) != 3 || x != 'x')
+    throw InvalidInput("--size: expected WIDTHxHEIGHT in pixels, such as 1200x900, got \"" + args.size + "\"");
+  options.picture.width = w;
+  options.picture.height = h;
+  options.printability = args.print.enabled;
+  options.print.min_wall_mm = args.print.min_wall;
+  options.print.min_hole_mm = args.print.min_hole;
+  options.print.voxel_size_mm = args.print.voxel;
+  options.print.max_memory_bytes = base.max_memory_bytes;
+  if (args.print.enabled) options.print.build_direction = parse_direction(args.print.build_dir);
+  const RenderFileResult result = render_file(args.input, args.output, options);
+  if (flags.json) {
+    std::cout << nlohmann::json{{"file", args.output}, {"width", result.picture.width}, {"height", result.picture.height},
+                                {"triangles", result.triangles}, {"markers", result.markers}}
+                     .dump(2)
+              << "\n";
+  } else if (!flags.quiet) {
+    std::printf("lacuna: wrote %s  (%d x %d, %zu views, %zu triangles, %zu markers)\n", args.output.c_str(),
+                result.picture.width, result.picture.height, result.picture.views.size(), result.triangles,
+                result.markers);
+  }
+  return kExitOk;
 }
 
 struct FeaArgs {
@@ -294,6 +335,25 @@ int run_app(int argc, char** argv) {
   fea->add_option("--voxel-size", run_options.voxel_size_mm, "Voxel size in mm for a recipe, overriding its own")
       ->check(number_in(kMinVoxelSizeMm, kMaxVoxelSizeMm));
   add_common(fea, flags);
+  RenderArgs render_args;
+  CLI::App* render = app.add_subcommand(
+      "render", "Pictures of a mesh file or of a recipe's object (PNG; no GPU or display needed): shaded views with\n"
+                "the object's name, a scale bar in mm, and markers at printability findings with --print");
+  render->add_option("INPUT", render_args.input, "Mesh (.stl .obj .ply .3mf .drc) or recipe (.json)")->required();
+  render->add_option("-o,--output", render_args.output, "Output picture (.png)")->required();
+  render->add_option("--views", render_args.views, "Comma-separated views: iso, front, top, side (default iso)");
+  render->add_option("--size", render_args.size, "WIDTHxHEIGHT in pixels, 64 to 8192 each (default 1200x900)");
+  render->add_option("--object", render_args.object, "A recipe's input or operation (default: its first output's)");
+  render->add_flag("--print", render_args.print.enabled, "Analyse printability and mark trapped voids, thin walls, small holes");
+  render->add_option("--min-wall", render_args.print.min_wall, "With --print: thinnest wall allowed, mm")->check(non_negative_number());
+  render->add_option("--min-hole", render_args.print.min_hole, "With --print: narrowest hole allowed, mm")->check(non_negative_number());
+  render->add_option("--print-voxel-size", render_args.print.voxel, "With --print: voxel size of the analysis, mm")
+      ->check(number_in(kMinVoxelSizeMm, kMaxVoxelSizeMm));
+  render->add_option("--voxel-size", run_options.voxel_size_mm, "Voxel size in mm for a recipe, overriding its own")
+      ->check(number_in(kMinVoxelSizeMm, kMaxVoxelSizeMm));
+  render->add_option("--max-memory", max_memory_gb, "Memory budget in GB (default: half of the machine's memory)")
+      ->check(number_in(0, 1e9, true));
+  add_common(render, flags);
   std::function<int()> cifs_command = add_cifs_commands(app);
   std::function<int()> curve_command = add_curve_commands(app);
   std::function<int()> fill_command = add_fill_commands(app);
@@ -320,6 +380,7 @@ int run_app(int argc, char** argv) {
     if (*run_command) return command_run(recipe, run_options, flags);
     if (*check) return command_check(mesh_path, flags, print, run_options.max_memory_bytes);
     if (*fea) return command_fea(fea_args, run_options, flags);
+    if (*render) return command_render(render_args, run_options, flags);
     for (const auto& command : {cifs_command, curve_command, fill_command, voronoi_command, bcifs_command}) {
       const int code = command();
       if (code >= 0) return code;

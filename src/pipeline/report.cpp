@@ -122,6 +122,7 @@ nlohmann::json to_json(const OutputReport& out) {
   entry["simplify_mm"] = out.simplify_mm;
   entry["extracted_triangles"] = out.extracted_triangles;
   if (out.draco) entry["draco"] = to_json(*out.draco);
+  if (!out.picture.empty()) entry["picture"] = out.picture;
   annotate(entry, out);
   return entry;
 }

@@ -113,6 +113,7 @@ struct OutputReport {
   uint64_t extracted_triangles = 0;   // of the surface before simplification
   std::optional<MeshCheckReport> check;  // surface outputs: the file as read back
   std::optional<DracoFigures> draco;     // .drc outputs: quantization and size
+  std::string picture;                   // the PNG rendered of it ("render"), final path; empty: none
   std::optional<TetCheck> tetrahedra;    // tetrahedral outputs
   std::optional<PrintabilityFindings> printability;
   std::optional<double> hull_volume_mm3;  // infill objects: the hull's volume, for the relative density

@@ -18,6 +18,7 @@
 #include "pipeline/draco_output.h"
 #include "pipeline/fea_output.h"
 #include "pipeline/mesh_object.h"
+#include "pipeline/render_output.h"
 #include "solids/check.h"
 #include "solids/components.h"
 #include "solids/printability.h"
@@ -197,6 +198,7 @@ RunReport write_outputs(const Recipe& recipe, const Plan& plan, Evaluation&& eva
         entry.simplify_mm = simplify_deviation_mm(recipe, out);
         entry.extracted_triangles = surface.extracted_triangles;
         entry.printability = printability;
+        if (out.render) entry.picture = (out_dir / out.render->file).string();
         auto hull = evaluation.hull_volume_mm3.find(out.object);
         if (hull != evaluation.hull_volume_mm3.end()) entry.hull_volume_mm3 = hull->second;
         return entry;
@@ -207,6 +209,22 @@ RunReport write_outputs(const Recipe& recipe, const Plan& plan, Evaluation&& eva
         std::string final_path;
       };
       std::vector<Written> written;
+      // Pictures of this object's outputs that ask for one, with markers at what printability found.
+      for (const RecipeOutput& out : recipe.outputs) {
+        if (out.object != object || !out.render) continue;
+        timer.start("render");
+        RenderOptions picture;
+        picture.width = out.render->width;
+        picture.height = out.render->height;
+        picture.views.clear();
+        for (const std::string& v : out.render->views) picture.views.push_back(render_view_from_name(v, out.json_path));
+        picture.title = out.part_name;
+        if (printability)
+          picture.markers = printability_markers(printability->trapped_voids, printability->thin_walls,
+                                                 printability->small_holes);
+        const std::string path = (out_dir / out.render->file).string();
+        write_picture_png(transaction.stage(path), render_mesh(surface_for(out).mesh, picture));
+      }
       for (const RecipeOutput& out : recipe.outputs) {
         if (!out.group.empty()) {
           if (std::find(out.group.begin(), out.group.end(), object) == out.group.end()) continue;
@@ -317,7 +335,10 @@ RunReport write_outputs(const Recipe& recipe, const Plan& plan, Evaluation&& eva
       write_text_file_atomically(transaction.stage(report_path), to_json(report).dump(2) + "\n");
     transaction.commit();
     folder.keep();
-    for (const OutputReport& o : report.outputs) report.written.push_back(o.file);
+    for (const OutputReport& o : report.outputs) {
+      report.written.push_back(o.file);
+      if (!o.picture.empty()) report.written.push_back(o.picture);
+    }
     if (options.write_report) report.written.push_back(report_path);
     return report;
   } catch (const Error& e) {

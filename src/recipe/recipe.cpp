@@ -294,7 +294,7 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
   std::set<std::string> files;
   for (size_t i = 0; i < outs.size(); ++i) {
     JsonObject o(outs[i], path, "outputs[" + std::to_string(i) + "]");
-    o.allow_only({"of", "file", "name", "simplify_mm", "decimate_mm", "fea", "quantize_mm"});
+    o.allow_only({"of", "file", "name", "simplify_mm", "decimate_mm", "fea", "quantize_mm", "render"});
     RecipeOutput out;
     out.json_path = o.path();
     auto known = [&](const std::string& name) {
@@ -371,6 +371,44 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
           out.fea.regions.push_back(r.get<std::string>());
         }
       }
+    }
+    if (o.has("render")) {
+      if (tetrahedral) o.fail("render", "pictures are made of surface outputs (.stl, .3mf, .drc)");
+      if (!out.group.empty()) o.fail("render", "pictures are made of one object: give \"render\" on an output of one");
+      RecipeOutput::Render render;
+      const nlohmann::json& r = o.required("render");
+      if (r.is_string()) {
+        render.file = r.get<std::string>();
+      } else {
+        JsonObject ro = o.object("render");
+        ro.allow_only({"file", "views", "size"});
+        render.file = ro.string("file");
+        if (ro.has("views")) {
+          const nlohmann::json& views = ro.required("views");
+          if (!views.is_array() || views.empty()) ro.fail("views", "expected a list of \"iso\", \"front\", \"top\", \"side\"");
+          render.views.clear();
+          for (const auto& v : views) {
+            static const std::set<std::string> view_names = {"iso", "front", "top", "side"};
+            if (!v.is_string() || !view_names.count(v.get<std::string>()))
+              ro.fail("views", "expected \"iso\", \"front\", \"top\" or \"side\", got " + v.dump());
+            render.views.push_back(v.get<std::string>());
+          }
+        }
+        if (ro.has("size")) {
+          const nlohmann::json& size = ro.required("size");
+          if (!size.is_array() || size.size() != 2 || !size[0].is_number_integer() || !size[1].is_number_integer() ||
+              size[0].get<int64_t>() < 64 || size[0].get<int64_t>() > 8192 || size[1].get<int64_t>() < 64 ||
+              size[1].get<int64_t>() > 8192)
+            ro.fail("size", "expected [width, height] in pixels, each 64 to 8192");
+          render.width = int(size[0].get<int64_t>());
+          render.height = int(size[1].get<int64_t>());
+        }
+      }
+      if (!plain_file_name(render.file) || lower(fs::path(render.file).extension().string()) != ".png")
+        o.fail("render", "expected a plain file name ending in .png, such as \"part.png\"");
+      if (lower(render.file) == "report.json" || !files.insert(lower(render.file)).second)
+        o.fail("render", "\"" + render.file + "\" is written twice");
+      out.render = render;
     }
     out.part_name = o.string_or("name", out.object);
     if (has_control_character(out.part_name)) o.fail("name", "an object name may not hold control characters");

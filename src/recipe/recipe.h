@@ -98,6 +98,13 @@ struct RecipeOutput {
   std::optional<double> simplify_mm;
   // .drc: the most any vertex may move by quantization (mm); unset: a tenth of the voxel size.
   std::optional<double> quantize_mm;
+  // A picture of the output's surface beside it (PNG), with markers at printability findings.
+  struct Render {
+    std::string file;                     // a plain .png file name in the output folder
+    int width = 1200, height = 900;       // pixels
+    std::vector<std::string> views{"iso"};  // "iso", "front", "top", "side"
+  };
+  std::optional<Render> render;
   FeaSettings fea;        // for tetrahedral formats
   std::string json_path;
 };
