@@ -7,6 +7,7 @@ find_package(Eigen3 3.3 REQUIRED NO_MODULE)
 find_package(TBB REQUIRED)
 find_package(nlohmann_json 3.10 REQUIRED)
 find_package(CLI11 REQUIRED)
+find_package(ZLIB REQUIRED)  # compressed PNG pictures
 
 # FindOpenVDB switches BUILD_SHARED_LIBS on in the calling scope; keep our own setting.
 set(_lacuna_shared "${BUILD_SHARED_LIBS}")

@@ -23,9 +23,6 @@ namespace {
 // the TriMesh it becomes (measured order of magnitude, rounded up).
 constexpr double kDecodeBytesPerFace = 100;
 constexpr double kDecodeBytesPerPoint = 100;
-// Files whose header cannot be read for their counts (older bitstreams, metadata) are bounded by
-// their size: more than 1 KiB of mesh per byte of file is far beyond what Draco reaches on parts.
-constexpr double kDecodeBytesPerFileByte = 1024;
 
 struct Box {
   float min[3], max[3];
@@ -58,8 +55,8 @@ struct DeclaredCounts {
   uint64_t faces = 0, points = 0;
 };
 
-// The face and point counts a version 2.2 mesh declares in its connectivity header (Draco
-// bitstream specification: header, then for sequential encoding num_faces and num_points, for
+// The face and point counts a version 2.2 mesh without metadata declares in its connectivity header
+// (Draco bitstream specification: header, then for sequential encoding num_faces and num_points, for
 // edgebreaker the traversal type, num_encoded_vertices and num_faces); nothing for other files.
 std::optional<DeclaredCounts> declared_counts(std::string_view bytes) {
   constexpr size_t kHeader = 11;
@@ -145,15 +142,22 @@ TriMesh decode_draco(std::string_view bytes, const std::string& label, const Rea
   if (bytes.size() < 11 || bytes.substr(0, 5) != "DRACO")
     throw InvalidInput(label + ": not a Draco file (it does not start with \"DRACO\")");
   if (uint8_t(bytes[7]) != 1) throw InvalidInput(label + ": a Draco point cloud, not a triangle mesh");
+  // Older bitstreams store their counts elsewhere, and Draco allocates for them before checking them
+  // against the data (found by fuzzing: a 100-byte version 1.x file asked for gigabytes); metadata
+  // comes before the counts. Only what can be bounded first is decoded.
+  if (uint8_t(bytes[5]) != 2 || uint8_t(bytes[6]) != 2)
+    throw InvalidInput(label + ": Draco bitstream version " + std::to_string(uint8_t(bytes[5])) + "." +
+                       std::to_string(uint8_t(bytes[6])) + "; this reader takes version 2.2 (Draco 1.4 and later)");
+  if (uint8_t(bytes[10]) & 0x80)
+    throw InvalidInput(label + ": the Draco file carries metadata; this reader takes meshes without (re-encode it "
+                       "with draco_encoder)");
   const std::optional<DeclaredCounts> counts = declared_counts(bytes);
-  const double need = counts ? kDecodeBytesPerFace * double(counts->faces) + kDecodeBytesPerPoint * double(counts->points)
-                             : kDecodeBytesPerFileByte * double(bytes.size());
+  if (!counts) throw InvalidInput(label + ": malformed Draco header (no face and vertex counts)");
+  const double need = kDecodeBytesPerFace * double(counts->faces) + kDecodeBytesPerPoint * double(counts->points);
   if (need > double(options.max_memory_bytes)) {
-    throw ResourceLimit(label + ": " +
-                        (counts ? std::to_string(counts->faces) + " triangles and " + std::to_string(counts->points) +
-                                      " vertices"
-                                : std::string("the file")) +
-                        " need about " + message_number(need / double(uint64_t{1} << 30)) +
+    throw ResourceLimit(label + ": " + std::to_string(counts->faces) + " triangles and " +
+                        std::to_string(counts->points) + " vertices need about " +
+                        message_number(need / double(uint64_t{1} << 30)) +
                         " GiB to decode, more than the memory limit of " +
                         message_number(double(options.max_memory_bytes) / double(uint64_t{1} << 30)) + " GiB");
   }
@@ -164,14 +168,21 @@ TriMesh decode_draco(std::string_view bytes, const std::string& label, const Rea
   if (!decoded.ok()) throw InvalidInput(label + ": malformed Draco mesh (" + decoded.status().error_msg_string() + ")");
   const std::unique_ptr<draco::Mesh> in = std::move(decoded).value();
   const draco::PointAttribute* position = in->GetNamedAttribute(draco::GeometryAttribute::POSITION);
-  if (!position || position->num_components() != 3)
-    throw InvalidInput(label + ": the Draco mesh has no three-component positions");
+  // Read as bytes (no typed loads from Draco's buffer, which a malformed file can misalign), each
+  // within the buffer.
+  if (!position || position->num_components() != 3 || position->data_type() != draco::DT_FLOAT32 ||
+      position->byte_stride() != 3 * int64_t(sizeof(float)) || !position->buffer() || position->byte_offset() < 0)
+    throw InvalidInput(label + ": the Draco mesh has no positions of three 32-bit floats");
+  const draco::DataBuffer& values = *position->buffer();
   TriMesh mesh;
   mesh.positions_mm.resize(in->num_points());
   for (uint32_t i = 0; i < in->num_points(); ++i) {
     float value[3];
-    if (!position->ConvertValue<float, 3>(position->mapped_index(draco::PointIndex(i)), value))
+    const draco::AttributeValueIndex index = position->mapped_index(draco::PointIndex(i));
+    const uint64_t at = uint64_t(position->byte_offset()) + uint64_t(sizeof value) * uint64_t(index.value());
+    if (index == draco::kInvalidAttributeValueIndex || at + sizeof value > uint64_t(values.data_size()))
       throw InvalidInput(label + ": vertex " + std::to_string(i) + " has no position");
+    std::memcpy(value, values.data() + at, sizeof value);
     for (float c : value)
       if (!std::isfinite(c)) throw InvalidInput(label + ": vertex " + std::to_string(i) + " is not finite");
     mesh.positions_mm[i] = Vec3d{value[0], value[1], value[2]};

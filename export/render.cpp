@@ -302,7 +302,7 @@ Picture render_mesh(const TriMesh& mesh, const RenderOptions& options) {
 }
 
 void write_picture_png(const std::string& path, const Picture& picture) {
-  bcifs::write_png(path, picture.width, picture.height, picture.rgb);
+  bcifs::write_png(path, picture.width, picture.height, picture.rgb, 6);
 }
 
 }  // namespace lacuna

@@ -25,7 +25,7 @@ esac
 
 packages=(build-essential cmake ninja-build ccache pkg-config
           libopenvdb-dev libboost-iostreams-dev libcgal-dev libgmp-dev libmpfr-dev libtet1.5-dev
-          libdraco-dev lib3mf-dev libzip-dev libeigen3-dev libtbb-dev
+          libdraco-dev lib3mf-dev libzip-dev zlib1g-dev libeigen3-dev libtbb-dev
           nlohmann-json3-dev libcli11-dev libgtest-dev
           python3-dev pybind11-dev python3-numpy)
 if [ "$mode" = test ]; then

@@ -140,6 +140,14 @@ TEST(Draco, MalformedFilesAreRefusedWithTheirName) {
       EXPECT_EQ(std::string(e.what()).rfind("cut.drc: ", 0), 0u) << e.what();
     }
   }
+  // Other bitstream versions and files with metadata: their counts cannot be bounded before Draco
+  // allocates (a 100-byte version 1.254 file found by fuzzing asked for gigabytes).
+  std::string old = good;
+  old[5] = 1, old[6] = char(254);
+  EXPECT_THROW(decode_draco(old, "old.drc"), InvalidInput);
+  std::string with_metadata = good;
+  with_metadata[10] = char(0x80);
+  EXPECT_THROW(decode_draco(with_metadata, "meta.drc"), InvalidInput);
   std::string cloud = good;
   cloud[7] = 0;  // encoder type: point cloud
   EXPECT_THROW(decode_draco(cloud, "cloud.drc"), InvalidInput);
@@ -232,6 +240,26 @@ TEST(Draco, RunWritesACheckedDracoOutputSmallerThanItsStl) {
   options.output_dir = (dir / "bad").string();
   EXPECT_THROW(run((dir / "bad.json").string(), options), InvalidInput);
   EXPECT_FALSE(fs::exists(dir / "bad"));
+}
+
+TEST(Draco, CheckFeaAndMeshInputsReadDracoFiles) {
+  TempDir dir;
+  const TriMesh ball = geodesic_sphere({0, 0, 0}, 4, 3);
+  ASSERT_TRUE(write_checked_draco((dir / "ball.drc").string(), ball, 0.001, uint64_t{1} << 30).check.valid());
+  test::Result r = test::lacuna("check " + test::quote((dir / "ball.drc").string()) + " --json", dir.path());
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"triangles\": " + std::to_string(ball.triangles.size())), std::string::npos) << r.out;
+  r = test::lacuna("fea " + test::quote((dir / "ball.drc").string()) + " -o " + test::quote((dir / "ball.msh").string()),
+                   dir.path());
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir / "ball.msh"));
+  write_file(dir / "hull.json", R"({"voxel_size_mm": 0.2, "inputs": {"hull": {"type": "mesh", "file": "ball.drc"}},
+      "outputs": [{"of": "hull", "file": "hull.stl"}]})");
+  r = test::lacuna("run " + test::quote((dir / "hull.json").string()) + " -o " + test::quote((dir / "out").string()),
+                   dir.path());
+  EXPECT_EQ(r.code, 0) << r.err;
+  const TriMesh hull = read_mesh((dir / "out" / "hull.stl").string());
+  EXPECT_NEAR(signed_volume(hull), signed_volume(ball), 0.02 * signed_volume(ball));
 }
 
 }  // namespace

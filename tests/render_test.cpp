@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
+#include <zlib.h>
 
 #include <cmath>
 #include <map>
@@ -185,6 +186,31 @@ std::pair<int, int> png_size(const fs::path& path) {
                (uint32_t(uint8_t(png[at + 2])) << 8) | uint32_t(uint8_t(png[at + 3])));
   };
   return {be(16), be(20)};
+}
+
+TEST(Render, PngIsCompressedAndInflatesToThePixels) {
+  RenderOptions options;
+  options.width = 320;
+  options.height = 200;
+  const Picture picture = render_mesh(geodesic_sphere(3, 3), options);
+  TempDir dir;
+  write_picture_png((dir / "p.png").string(), picture);
+  const std::string png = test::read_file(dir / "p.png");
+  // One IDAT chunk after the signature and IHDR (8 + 25 bytes): zlib's inflate gives the scanlines,
+  // each a filter byte 0 and the row's pixels.
+  ASSERT_EQ(png.substr(37, 4), "IDAT");
+  const uint32_t length = (uint32_t(uint8_t(png[33])) << 24) | (uint32_t(uint8_t(png[34])) << 16) |
+                          (uint32_t(uint8_t(png[35])) << 8) | uint32_t(uint8_t(png[36]));
+  std::vector<uint8_t> raw(size_t(picture.height) * (1 + 3 * size_t(picture.width)));
+  uLongf raw_size = uLongf(raw.size());
+  ASSERT_EQ(uncompress(raw.data(), &raw_size, reinterpret_cast<const Bytef*>(png.data() + 41), length), Z_OK);
+  ASSERT_EQ(raw_size, raw.size());
+  for (int y = 0; y < picture.height; ++y) {
+    const uint8_t* row = raw.data() + size_t(y) * (1 + 3 * size_t(picture.width));
+    ASSERT_EQ(row[0], 0);
+    ASSERT_TRUE(std::equal(row + 1, row + 1 + 3 * picture.width, picture.rgb.begin() + 3 * long(y) * picture.width)) << y;
+  }
+  EXPECT_LT(png.size(), picture.rgb.size() / 10);  // mostly background: far smaller than the pixels
 }
 
 TEST(Render, RecipeOutputsWriteTheirPicture) {

@@ -1,5 +1,7 @@
 #include "bcifs/realize.h"
 
+#include <zlib.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -653,7 +655,7 @@ uint32_t adler32(const uint8_t* data, size_t size) {
   return (b << 16) | a;
 }
 
-std::vector<uint8_t> encode_png(int width, int height, const std::vector<uint8_t>& rgb) {
+std::vector<uint8_t> encode_png(int width, int height, const std::vector<uint8_t>& rgb, int level) {
   if (width < 1 || height < 1 || rgb.size() != 3 * size_t(width) * size_t(height))
     throw InvalidInput("encode_png: expected " + std::to_string(width) + " x " + std::to_string(height) +
                        " RGB pixels (3 bytes each)");
@@ -665,8 +667,17 @@ std::vector<uint8_t> encode_png(int width, int height, const std::vector<uint8_t
     raw.insert(raw.end(), rgb.begin() + long(3 * size_t(y) * size_t(width)),
                rgb.begin() + long(3 * size_t(y + 1) * size_t(width)));
   }
-  std::vector<uint8_t> z{0x78, 0x01};
-  for (size_t at = 0; at < raw.size() || at == 0;) {
+  std::vector<uint8_t> z;
+  if (level > 0) {
+    uLongf size = compressBound(uLong(raw.size()));
+    z.resize(size);
+    if (compress2(z.data(), &size, raw.data(), uLong(raw.size()), std::min(level, 9)) != Z_OK)
+      throw InternalError("zlib could not compress a picture");
+    z.resize(size);
+  } else {
+    z = {0x78, 0x01};
+  }
+  for (size_t at = 0; level <= 0 && (at < raw.size() || at == 0);) {
     const size_t len = std::min<size_t>(65535, raw.size() - at);
     const bool last = at + len == raw.size();
     z.push_back(last ? 1 : 0);
@@ -678,8 +689,10 @@ std::vector<uint8_t> encode_png(int width, int height, const std::vector<uint8_t
     at += len;
     if (last) break;
   }
-  const uint32_t adler = adler32(raw.data(), raw.size());
-  for (int s = 24; s >= 0; s -= 8) z.push_back(uint8_t(adler >> s));
+  if (level <= 0) {
+    const uint32_t adler = adler32(raw.data(), raw.size());
+    for (int s = 24; s >= 0; s -= 8) z.push_back(uint8_t(adler >> s));
+  }
 
   std::vector<uint8_t> png{0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
   auto chunk = [&png](const char* type, const std::vector<uint8_t>& data) {
@@ -701,8 +714,8 @@ std::vector<uint8_t> encode_png(int width, int height, const std::vector<uint8_t
   return png;
 }
 
-void write_png(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb) {
-  const std::vector<uint8_t> png = encode_png(width, height, rgb);
+void write_png(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb, int level) {
+  const std::vector<uint8_t> png = encode_png(width, height, rgb, level);
   std::ofstream file(path, std::ios::binary);
   if (!file) throw IoError("cannot open '" + path + "' for writing");
   file.write(reinterpret_cast<const char*>(png.data()), std::streamsize(png.size()));

@@ -177,10 +177,11 @@ std::vector<uint8_t> density_colours(const std::vector<double>& density);
 
 uint32_t crc32(const uint8_t* data, size_t size);
 uint32_t adler32(const uint8_t* data, size_t size);
-// An 8-bit RGB PNG with stored (uncompressed) deflate blocks. Throws InvalidInput when rgb.size() != 3 w h.
-std::vector<uint8_t> encode_png(int width, int height, const std::vector<uint8_t>& rgb);
+// An 8-bit RGB PNG: stored (uncompressed) deflate blocks at `level` 0, zlib's deflate at levels 1-9.
+// Throws InvalidInput when rgb.size() != 3 w h.
+std::vector<uint8_t> encode_png(int width, int height, const std::vector<uint8_t>& rgb, int level = 0);
 // Throws IoError when the file cannot be written.
-void write_png(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb);
+void write_png(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb, int level = 0);
 
 // A two-panel plot, RGB width x height: left ln(A_i/A_0) (red) and ln(P_i/P_0) (blue) against i with markers;
 // right the box-counting points (black) and their fitted line (green). Axes in black, no text.
