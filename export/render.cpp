@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cctype>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -218,6 +219,15 @@ Picture render_mesh(const TriMesh& mesh, const RenderOptions& options) {
                      info.centre_y - (dot(p, cam.up) - info.mid_up) * info.pixels_per_mm, dot(p, cam.forward)};
       }
     });
+    // The section's height (mm along z); faces seen from behind through the cut are the cut solid.
+    double cut = HUGE_VAL;
+    if (options.section) {
+      if (!(*options.section >= 0 && *options.section <= 1))
+        throw InvalidInput("a section is a fraction of the part's height, 0 to 1");
+      double lo = HUGE_VAL, hi = -HUGE_VAL;
+      for (const Vec3d& p : mesh.positions_mm) lo = std::min(lo, p.z), hi = std::max(hi, p.z);
+      cut = lo + *options.section * (hi - lo);
+    }
     // Light from over the viewer's left shoulder; faces seen from behind (inside-out or open) in red.
     Vec3d light = cam.up * 0.5 - cam.forward - cam.right * 0.3;
     light = light / norm(light);
@@ -241,8 +251,13 @@ Picture render_mesh(const TriMesh& mesh, const RenderOptions& options) {
         const bool front = dot(normal, cam.forward) < 0;
         const double lambert = std::fabs(dot(normal, light));
         const double shade = 0.3 + 0.7 * lambert;
-        const Rgb colour = front ? Rgb{uint8_t(130 * shade + 20), uint8_t(150 * shade + 20), uint8_t(185 * shade + 25)}
-                                 : Rgb{uint8_t(200 * shade + 30), uint8_t(50 * shade + 10), uint8_t(50 * shade + 10)};
+        const bool capped = options.section.has_value();
+        const Rgb colour = front     ? Rgb{uint8_t(130 * shade + 20), uint8_t(150 * shade + 20), uint8_t(185 * shade + 25)}
+                           : capped ? Rgb{230, 170, 90}
+                                    : Rgb{uint8_t(200 * shade + 30), uint8_t(50 * shade + 10), uint8_t(50 * shade + 10)};
+        const double za = mesh.positions_mm[t[0]].z, zb = mesh.positions_mm[t[1]].z, zc = mesh.positions_mm[t[2]].z;
+        if (std::min({za, zb, zc}) > cut) continue;
+        const bool clipped = std::max({za, zb, zc}) > cut;
         const int x_lo = std::max(0, int(std::floor(std::min({a[0], b[0], c[0]}) - ax0)));
         const int x_hi = std::min(width - 1, int(std::ceil(std::max({a[0], b[0], c[0]}) - ax0)));
         const int y_lo = std::max(by0, int(std::floor(miny))), y_hi = std::min(by1 - 1, int(std::ceil(maxy)));
@@ -255,6 +270,7 @@ Picture render_mesh(const TriMesh& mesh, const RenderOptions& options) {
             const double w1 = ((c[0] - px) * (a[1] - py) - (c[1] - py) * (a[0] - px)) / area;
             const double w2 = 1 - w0 - w1;
             if (w0 < 0 || w1 < 0 || w2 < 0) continue;
+            if (clipped && w0 * za + w1 * zb + w2 * zc > cut) continue;
             const float z = float(w0 * a[2] + w1 * b[2] + w2 * c[2]);
             float& d = depth[size_t(y) * size_t(width) + size_t(x)];
             // Ties go to the smaller triangle index order as met: the same for any thread count,
@@ -279,6 +295,7 @@ Picture render_mesh(const TriMesh& mesh, const RenderOptions& options) {
     // Title and view at the top left; legend at the top right.
     std::string title = options.title.empty() ? std::string(render_view_name(view))
                                               : options.title + " - " + render_view_name(view);
+    for (char& ch : title) ch = char(std::toupper(static_cast<unsigned char>(ch)));  // one case: "FOAM", not "FOAm"
     canvas.text(info.x0 + kMargin, info.y0 + kMargin, title, kInk);
     int lx = info.x1 - kMargin;
     for (auto it = shown.rbegin(); it != shown.rend(); ++it) {

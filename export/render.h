@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,9 @@ struct RenderOptions {
   std::vector<RenderView> views = {RenderView::kIso};
   std::string title;               // the object's name, printed on every view
   std::vector<RenderMarker> markers;
+  // A section: everything above this fraction of the part's height (0 bottom, 1 top, along z) is
+  // cut away and the cut solid shown in a cap colour; unset: the whole part.
+  std::optional<double> section;
 };
 
 struct Picture {

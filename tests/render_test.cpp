@@ -98,6 +98,25 @@ TEST(Render, SilhouettesHaveTheirProjectedArea) {
   EXPECT_NEAR(b.views[0].pixels_per_mm * 20, (b.views[0].x1 - b.views[0].x0) - 16, 1e-9);
 }
 
+TEST(Render, ASectionCutsAtItsHeightAndShowsTheCutSolid) {
+  // A 20 x 10 x 10 box cut at half its height: from the front, 20 x 5 of it is left; from the top,
+  // the cut shows the solid (the cap colour) over the whole 20 x 10.
+  RenderOptions options;
+  options.width = options.height = 600;
+  options.views = {RenderView::kFront, RenderView::kTop};
+  options.section = 0.5;
+  const Picture p = render_mesh(box({0, 0, 0}, {20, 10, 10}), options);
+  const double s0 = p.views[0].pixels_per_mm, s1 = p.views[1].pixels_per_mm;
+  EXPECT_NEAR(double(part_pixels(p, 0)), 20 * 5 * s0 * s0, 2 * 25 * s0);
+  size_t cap = 0;
+  const Picture::ViewInfo& top = p.views[1];
+  for (int y = top.y0 + 38; y < top.y1 - 38; ++y)
+    for (int x = top.x0; x < top.x1; ++x) cap += pixel(p, x, y) == std::array<uint8_t, 3>{230, 170, 90};
+  EXPECT_NEAR(double(cap), 20 * 10 * s1 * s1, 2 * 30 * s1);
+  options.section = 1.5;
+  EXPECT_THROW(render_mesh(box({0, 0, 0}, {1, 1, 1}), options), InvalidInput);
+}
+
 TEST(Render, ScaleBarIsARoundLengthAtTheViewsScale) {
   RenderOptions options;
   options.width = 640;

@@ -73,8 +73,9 @@ int command_run(const std::string& recipe, const RunOptions& options, const Comm
                     out["file"].get<std::string>().c_str(), (unsigned long long)out["triangles"].get<uint64_t>(),
                     out["volume_mm3"].get<double>(), (unsigned long long)out["components"].get<uint64_t>(),
                     out["components"].get<uint64_t>() == 1 ? "" : "s", (long long)out["genus"].get<int64_t>());
+      if (out.contains("picture")) std::printf("  wrote %s  (picture)\n", out["picture"].get<std::string>().c_str());
     }
-    if (result.written.size() > r["outputs"].size()) std::printf("  wrote %s\n", result.written.back().c_str());
+    if (options.write_report) std::printf("  wrote %s\n", result.written.back().c_str());
   }
   return kExitOk;
 }
@@ -130,7 +131,8 @@ int command_check(const std::string& path, const CommonFlags& flags, const Print
 }
 
 struct RenderArgs {
-  std::string input, output, views = "iso", size = "1200x900", object;
+  std::string input, output, views = "iso", size = "1200x900", object, title;
+  double section = -1;  // >= 0: cut at this fraction of the height
   PrintArgs print;
 };
 
@@ -149,6 +151,8 @@ int command_render(const RenderArgs& args, const RunOptions& base, const CommonF
     throw InvalidInput("--size: expected WIDTHxHEIGHT in pixels, such as 1200x900, got \"" + args.size + "\"");
   options.picture.width = w;
   options.picture.height = h;
+  if (args.section >= 0) options.picture.section = args.section;
+  options.picture.title = args.title;
   options.printability = args.print.enabled;
   options.print.min_wall_mm = args.print.min_wall;
   options.print.min_hole_mm = args.print.min_hole;
@@ -344,6 +348,10 @@ int run_app(int argc, char** argv) {
   render->add_option("--views", render_args.views, "Comma-separated views: iso, front, top, side (default iso)");
   render->add_option("--size", render_args.size, "WIDTHxHEIGHT in pixels, 64 to 8192 each (default 1200x900)");
   render->add_option("--object", render_args.object, "A recipe's input or operation (default: its first output's)");
+  render->add_option("--title", render_args.title, "The name printed on each view (default: the object's or file's)");
+  render->add_option("--section", render_args.section,
+                     "Cut away what lies above this fraction of the height (0 to 1, along z) and show the cut solid")
+      ->check(number_in(0, 1));
   render->add_flag("--print", render_args.print.enabled, "Analyse printability and mark trapped voids, thin walls, small holes");
   render->add_option("--min-wall", render_args.print.min_wall, "With --print: thinnest wall allowed, mm")->check(non_negative_number());
   render->add_option("--min-hole", render_args.print.min_hole, "With --print: narrowest hole allowed, mm")->check(non_negative_number());

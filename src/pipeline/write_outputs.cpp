@@ -219,6 +219,7 @@ RunReport write_outputs(const Recipe& recipe, const Plan& plan, Evaluation&& eva
         picture.views.clear();
         for (const std::string& v : out.render->views) picture.views.push_back(render_view_from_name(v, out.json_path));
         picture.title = out.part_name;
+        picture.section = out.render->section;
         if (printability)
           picture.markers = printability_markers(printability->trapped_voids, printability->thin_walls,
                                                  printability->small_holes);

@@ -381,7 +381,11 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
         render.file = r.get<std::string>();
       } else {
         JsonObject ro = o.object("render");
-        ro.allow_only({"file", "views", "size"});
+        ro.allow_only({"file", "views", "size", "section"});
+        if (ro.has("section")) {
+          render.section = ro.number_or("section", 0.0);
+          if (!(*render.section >= 0 && *render.section <= 1)) ro.fail("section", "expected a fraction of the height, 0 to 1");
+        }
         render.file = ro.string("file");
         if (ro.has("views")) {
           const nlohmann::json& views = ro.required("views");

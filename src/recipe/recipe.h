@@ -103,6 +103,7 @@ struct RecipeOutput {
     std::string file;                     // a plain .png file name in the output folder
     int width = 1200, height = 900;       // pixels
     std::vector<std::string> views{"iso"};  // "iso", "front", "top", "side"
+    std::optional<double> section;          // cut at this fraction of the height (0 to 1, along z)
   };
   std::optional<Render> render;
   FeaSettings fea;        // for tetrahedral formats
