@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The AddressSanitizer + UndefinedBehaviorSanitizer build (-DLACUNA_SANITIZE=ON) in build-asan/, and the
 # test suite under it without the sample runs and the Python module (they take most of the time and
-# memory there). Not part of .ci/run: on 2 cores the build alone takes longer than CI's budget allows.
+# memory there). Not part of .ci/run: on 2 cores the build alone takes longer than CI's budget allows;
+# CI runs the unit tests of the generators, readers and checks sanitized in the fuzzing build instead.
 #
 #   scripts/sanitize.sh            build, then the fast tests
 #   scripts/sanitize.sh -R Cli     ... only the tests matching a CTest regular expression
