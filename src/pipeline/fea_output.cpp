@@ -61,17 +61,21 @@ TetCheck write_tetrahedra(const TriMesh& surface, const std::string& output_path
   FeaResult fea = make_fea_mesh(surface, settings);
   if (!fea.check.valid()) return fea.check;
   OutputTransaction transaction;
-  FeaWriteOptions w;
-  w.msh_version_2 = settings.msh_version_2;
-  w.quadratic = settings.quadratic;
   try {
-    write_fea(transaction.stage(output_path), fea_format_from_path(output_path), fea.mesh, w);
+    write_fea(transaction.stage(output_path), fea_format_from_path(output_path), fea.mesh, fea_write_options(settings));
     transaction.commit();
   } catch (const IoError& e) {
     // Named as the file asked for, not its hidden temporary.
     throw IoError(transaction.with_final_names(e.what()));
   }
   return fea.check;
+}
+
+FeaWriteOptions fea_write_options(const FeaSettings& settings) {
+  FeaWriteOptions w;
+  w.msh_version_2 = settings.msh_version_2;
+  w.quadratic = settings.quadratic;
+  return w;
 }
 
 nlohmann::json fea_report_json(const TetCheck& r) {

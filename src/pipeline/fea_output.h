@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "export/fea.h"
 #include "geometry.h"
 #include "recipe/recipe.h"
 #include "solids/check.h"
@@ -40,6 +41,9 @@ TetCheck write_tetrahedra(const std::string& mesh_path, const std::string& outpu
 
 // The same for a surface in memory (not simplified here).
 TetCheck write_tetrahedra(const TriMesh& surface, const std::string& output_path, const FeaSettings& settings);
+
+// How a tetrahedral output's settings ask for it to be written (Gmsh version, element order).
+FeaWriteOptions fea_write_options(const FeaSettings& settings);
 
 // The report entry of a tetrahedral output.
 nlohmann::json fea_report_json(const TetCheck& check);

@@ -281,10 +281,8 @@ RunReport write_outputs(const Recipe& recipe, const Plan& plan, Evaluation&& eva
         }
         if (fea.check.valid()) {
           timer.start("write");
-          FeaWriteOptions w;
-          w.msh_version_2 = out.fea.msh_version_2;
-          w.quadratic = out.fea.quadratic;
-          write_fea(transaction.stage(final_path), fea_format_from_path(final_path), fea.mesh, w);
+          write_fea(transaction.stage(final_path), fea_format_from_path(final_path), fea.mesh,
+                    fea_write_options(out.fea));
         }
         OutputReport entry = entry_for(out, final_path);
         entry.tetrahedra = std::move(fea.check);
