@@ -539,7 +539,7 @@ void add_solids(py::module_& m) {
             }
             return r.meshes_cache;
           },
-          "The surface outputs (STL, 3MF) by file name, as Mesh objects read back from the files written (once, when "
+          "The surface outputs (STL, 3MF, Draco) by file name, as Mesh objects read back from the files written (once, when "
           "first asked for).");
 
   m.def(
@@ -573,7 +573,7 @@ void add_solids(py::module_& m) {
         RunResult out;
         out.report = from_json(report);
         for (const OutputReport& o2 : result.outputs)
-          if (o2.format == "stl" || o2.format == "3mf")
+          if (o2.format == "stl" || o2.format == "3mf" || o2.format == "drc")
             out.surfaces.emplace_back(fs::path(o2.file).filename().string(), o2.file);
         return out;
       },

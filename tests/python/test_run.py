@@ -47,6 +47,18 @@ def test_run_gives_the_command_line_report(tmp_path, cli):
     assert meshes["cut.stl"].genus == entry["genus"] == 1
 
 
+def test_draco_outputs_and_pictures(tmp_path):
+    recipe = dict(RECIPE, outputs=[{"of": "cut", "file": "cut.drc", "render": "cut.png"}])
+    result = lacuna.run(recipe, output_dir=tmp_path / "out")
+    entry = result.report["outputs"][0]
+    assert entry["draco"]["file_bytes"] == (tmp_path / "out" / "cut.drc").stat().st_size
+    assert entry["picture"] == str(tmp_path / "out" / "cut.png")
+    assert result.files == [str(tmp_path / "out" / n) for n in ("cut.drc", "cut.png", "report.json")]
+    back = result.meshes["cut.drc"]
+    assert back.faces.shape[0] == entry["triangles"] and back.genus == entry["genus"] == 1
+    assert back.volume_mm3 == pytest.approx(entry["volume_mm3"], rel=1e-9)
+
+
 def test_dicts_and_json_text(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     from_dict = lacuna.run(RECIPE)

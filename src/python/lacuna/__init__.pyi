@@ -168,7 +168,7 @@ class RunResult:
     def files(self) -> List[str]: ...
     @property
     def meshes(self) -> Dict[str, Mesh]:
-        """The STL and 3MF outputs by file name, read back when first asked for."""
+        """The STL, 3MF and Draco outputs by file name, read back when first asked for."""
 
 def run(
     recipe: _Recipe,
