@@ -55,15 +55,13 @@ struct DeclaredCounts {
   uint64_t faces = 0, points = 0;
 };
 
-// The face and point counts a version 2.2 mesh without metadata declares in its connectivity header
-// (Draco bitstream specification: header, then for sequential encoding num_faces and num_points, for
-// edgebreaker the traversal type, num_encoded_vertices and num_faces); nothing for other files.
+// The face and point counts a version 2.2 mesh without metadata (the caller has checked both)
+// declares in its connectivity header (Draco bitstream specification: the 11-byte header, then for
+// sequential encoding num_faces and num_points, for edgebreaker the traversal type,
+// num_encoded_vertices and num_faces); nothing when they are cut off or the method is unknown.
 std::optional<DeclaredCounts> declared_counts(std::string_view bytes) {
   constexpr size_t kHeader = 11;
-  if (bytes.size() < kHeader) return std::nullopt;
-  const auto major = uint8_t(bytes[5]), minor = uint8_t(bytes[6]), method = uint8_t(bytes[8]);
-  const unsigned flags = uint8_t(bytes[9]) | unsigned(uint8_t(bytes[10])) << 8;
-  if (major != 2 || minor != 2 || (flags & 0x8000)) return std::nullopt;
+  const auto method = uint8_t(bytes[8]);
   size_t at = kHeader;
   DeclaredCounts counts;
   if (method == 0) {
@@ -81,26 +79,38 @@ std::optional<DeclaredCounts> declared_counts(std::string_view bytes) {
   return counts;
 }
 
-}  // namespace
-
-double draco_move_bound_mm(const TriMesh& mesh, int bits) {
-  const Box b = float_box(mesh);
+// What Draco's grid spans: the largest side of the float box, and the largest coordinate.
+struct GridSpan {
   double range = 0, largest = 0;
+};
+
+GridSpan grid_span(const TriMesh& mesh) {
+  const Box b = float_box(mesh);
+  GridSpan g;
   for (int k = 0; k < 3; ++k) {
-    range = std::max(range, double(b.max[k]) - double(b.min[k]));
-    largest = std::max({largest, std::fabs(double(b.min[k])), std::fabs(double(b.max[k]))});
+    g.range = std::max(g.range, double(b.max[k]) - double(b.min[k]));
+    g.largest = std::max({g.largest, std::fabs(double(b.min[k])), std::fabs(double(b.max[k]))});
   }
-  if (!(range > 0)) range = 1;  // Draco's own choice for a flat box
-  const double step = range / double((uint64_t{1} << bits) - 1);
+  if (!(g.range > 0)) g.range = 1;  // Draco's own choice for a flat box
+  return g;
+}
+
+double move_bound(const GridSpan& g, int bits) {
+  const double step = g.range / double((uint64_t{1} << bits) - 1);
   // Half a step from rounding to the grid; float32 rounding of the input, of the dequantized
   // offset and of its sum with the box's corner: a few units in the last place of the largest value.
-  const double ulp = largest * std::ldexp(1.0, -23);
+  const double ulp = g.largest * std::ldexp(1.0, -23);
   return std::sqrt(3.0) * (0.5 * step + 4 * ulp);
 }
 
+}  // namespace
+
+double draco_move_bound_mm(const TriMesh& mesh, int bits) { return move_bound(grid_span(mesh), bits); }
+
 int draco_quantization_bits(const TriMesh& mesh, double max_move_mm) {
+  const GridSpan g = grid_span(mesh);
   for (int bits = 1; bits <= kMaxDracoBits; ++bits)
-    if (draco_move_bound_mm(mesh, bits) <= max_move_mm) return bits;
+    if (move_bound(g, bits) <= max_move_mm) return bits;
   return 0;
 }
 

@@ -123,20 +123,27 @@ void OutputTransaction::rollback() {
   }
 }
 
-void write_text_file_atomically(const std::string& path, const std::string& text) {
-  OutputTransaction transaction;
-  std::string temp = transaction.stage(path);
-  std::FILE* file = std::fopen(temp.c_str(), "wb");
+void write_whole_file(const std::string& path, const std::string& bytes) {
+  std::FILE* file = std::fopen(path.c_str(), "wb");
   if (!file) {
     throw IoError("cannot create '" + path + "': " + std::strerror(errno));
   }
-  bool written = std::fwrite(text.data(), 1, text.size(), file) == text.size();
+  bool written = std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size();
   int error = errno;
   if (std::fclose(file) != 0 && written) {
     written = false;
     error = errno;
   }
   if (!written) throw IoError("cannot write '" + path + "': " + std::strerror(error));
+}
+
+void write_text_file_atomically(const std::string& path, const std::string& text) {
+  OutputTransaction transaction;
+  try {
+    write_whole_file(transaction.stage(path), text);
+  } catch (const IoError& e) {
+    throw IoError(transaction.with_final_names(e.what()));  // named as asked, not as its temporary
+  }
   transaction.commit();
 }
 

@@ -44,6 +44,9 @@ class OutputTransaction {
   bool done_ = false;
 };
 
+// Writes `bytes` as the whole file `path` (created or truncated). Throws IoError naming it on failure.
+void write_whole_file(const std::string& path, const std::string& bytes);
+
 // Writes a whole text file through a temporary name and a rename. Throws IoError on failure.
 void write_text_file_atomically(const std::string& path, const std::string& text);
 

@@ -161,10 +161,18 @@ const char* render_view_name(RenderView view) {
   return "";
 }
 
-Vec2d project_to_picture(const Picture& picture, size_t view, const Vec3d& p) {
-  const Picture::ViewInfo& v = picture.views.at(view);
+namespace {
+
+// Where a point lands in a view (pixels, x right, y down).
+Vec2d project(const Picture::ViewInfo& v, const Vec3d& p) {
   return {v.centre_x + (dot(p, v.right) - v.mid_right) * v.pixels_per_mm,
           v.centre_y - (dot(p, v.up) - v.mid_up) * v.pixels_per_mm};
+}
+
+}  // namespace
+
+Vec2d project_to_picture(const Picture& picture, size_t view, const Vec3d& p) {
+  return project(picture.views.at(view), p);
 }
 
 Picture render_mesh(const TriMesh& mesh, const RenderOptions& options) {
@@ -172,6 +180,16 @@ Picture render_mesh(const TriMesh& mesh, const RenderOptions& options) {
     throw InvalidInput("a picture is 64 x 64 to 8192 x 8192 pixels, not " + std::to_string(options.width) + " x " +
                        std::to_string(options.height));
   if (options.views.empty()) throw InvalidInput("a picture needs at least one view");
+  // The section's height (mm along z); faces seen from behind through the cut are the cut solid.
+  double cut = HUGE_VAL;
+  const bool capped = options.section.has_value();
+  if (capped) {
+    if (!(*options.section >= 0 && *options.section <= 1))
+      throw InvalidInput("a section is a fraction of the part's height, 0 to 1");
+    double lo = HUGE_VAL, hi = -HUGE_VAL;
+    for (const Vec3d& p : mesh.positions_mm) lo = std::min(lo, p.z), hi = std::max(hi, p.z);
+    cut = lo + *options.section * (hi - lo);
+  }
   Picture picture;
   picture.width = options.width;
   picture.height = options.height;
@@ -214,20 +232,10 @@ Picture render_mesh(const TriMesh& mesh, const RenderOptions& options) {
     std::vector<std::array<double, 3>> screen(mesh.positions_mm.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, screen.size(), 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t k = r.begin(); k < r.end(); ++k) {
-        const Vec3d& p = mesh.positions_mm[k];
-        screen[k] = {info.centre_x + (dot(p, cam.right) - info.mid_right) * info.pixels_per_mm,
-                     info.centre_y - (dot(p, cam.up) - info.mid_up) * info.pixels_per_mm, dot(p, cam.forward)};
+        const Vec2d at = project(info, mesh.positions_mm[k]);
+        screen[k] = {at.x, at.y, dot(mesh.positions_mm[k], cam.forward)};
       }
     });
-    // The section's height (mm along z); faces seen from behind through the cut are the cut solid.
-    double cut = HUGE_VAL;
-    if (options.section) {
-      if (!(*options.section >= 0 && *options.section <= 1))
-        throw InvalidInput("a section is a fraction of the part's height, 0 to 1");
-      double lo = HUGE_VAL, hi = -HUGE_VAL;
-      for (const Vec3d& p : mesh.positions_mm) lo = std::min(lo, p.z), hi = std::max(hi, p.z);
-      cut = lo + *options.section * (hi - lo);
-    }
     // Light from over the viewer's left shoulder; faces seen from behind (inside-out or open) in red.
     Vec3d light = cam.up * 0.5 - cam.forward - cam.right * 0.3;
     light = light / norm(light);
@@ -251,7 +259,6 @@ Picture render_mesh(const TriMesh& mesh, const RenderOptions& options) {
         const bool front = dot(normal, cam.forward) < 0;
         const double lambert = std::fabs(dot(normal, light));
         const double shade = 0.3 + 0.7 * lambert;
-        const bool capped = options.section.has_value();
         const Rgb colour = front     ? Rgb{uint8_t(130 * shade + 20), uint8_t(150 * shade + 20), uint8_t(185 * shade + 25)}
                            : capped ? Rgb{230, 170, 90}
                                     : Rgb{uint8_t(200 * shade + 30), uint8_t(50 * shade + 10), uint8_t(50 * shade + 10)};
@@ -285,9 +292,8 @@ Picture render_mesh(const TriMesh& mesh, const RenderOptions& options) {
     });
     // Markers over the part, with a legend of the kinds shown.
     std::vector<RenderMarker::Kind> shown;
-    picture.views.push_back(info);
     for (const RenderMarker& m : options.markers) {
-      const Vec2d at = project_to_picture(picture, size_t(i), m.location_mm);
+      const Vec2d at = project(info, m.location_mm);
       canvas.ring(at.x, at.y, 9, 4, kInk);
       canvas.ring(at.x, at.y, 9, 2.5, marker_colour(m.kind));
       if (std::find(shown.begin(), shown.end(), m.kind) == shown.end()) shown.push_back(m.kind);
@@ -313,7 +319,7 @@ Picture render_mesh(const TriMesh& mesh, const RenderOptions& options) {
     canvas.fill(bar_x, bar_y - 6, bar_x + 2, bar_y + 6, kInk);
     canvas.fill(bar_x + info.bar_pixels - 2, bar_y - 6, bar_x + info.bar_pixels, bar_y + 6, kInk);
     canvas.text(bar_x + info.bar_pixels + 3 * kFontScale, bar_y - kTextH / 2, length_label(info.bar_mm), kInk);
-    picture.views.back() = info;
+    picture.views.push_back(info);
   }
   return picture;
 }

@@ -20,54 +20,18 @@
 #include "pipeline/draco_output.h"
 #include "pipeline/pipeline.h"
 #include "solids/check.h"
+#include "tests/mesh_fixtures.h"
 #include "tests/test_support.h"
 
 namespace lacuna {
 namespace {
 
 namespace fs = std::filesystem;
+using test::geodesic_sphere;
 using test::TempDir;
 using test::write_file;
 
-// An octahedron subdivided `levels` times and pushed onto the sphere of radius r about c.
-TriMesh geodesic_sphere(const Vec3d& c, double r, int levels) {
-  TriMesh m;
-  m.positions_mm = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-  m.triangles = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
-  for (int l = 0; l < levels; ++l) {
-    std::map<std::pair<uint32_t, uint32_t>, uint32_t> middle;
-    auto mid = [&](uint32_t a, uint32_t b) {
-      auto key = std::minmax(a, b);
-      auto it = middle.find(key);
-      if (it != middle.end()) return it->second;
-      m.positions_mm.push_back((m.positions_mm[a] + m.positions_mm[b]) * 0.5);
-      return middle[key] = uint32_t(m.positions_mm.size() - 1);
-    };
-    std::vector<std::array<uint32_t, 3>> next;
-    for (auto [a, b, d] : m.triangles) {
-      const uint32_t ab = mid(a, b), bd = mid(b, d), da = mid(d, a);
-      next.push_back({a, ab, da});
-      next.push_back({ab, b, bd});
-      next.push_back({da, bd, d});
-      next.push_back({ab, bd, da});
-    }
-    m.triangles = std::move(next);
-  }
-  for (Vec3d& p : m.positions_mm) p = c + p * (r / norm(p));
-  return m;
-}
 
-// An axis-aligned box as 8 corners and 12 outward triangles.
-void add_box(TriMesh& m, const Vec3d& lo, const Vec3d& hi) {
-  const auto base = uint32_t(m.positions_mm.size());
-  for (int i = 0; i < 8; ++i)
-    m.positions_mm.push_back({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
-  const uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  for (const auto& q : quads) {
-    m.triangles.push_back({base + q[0], base + q[1], base + q[2]});
-    m.triangles.push_back({base + q[0], base + q[2], base + q[3]});
-  }
-}
 
 // Each decoded vertex's nearest original vertex (brute force: small meshes only).
 std::vector<uint32_t> nearest_originals(const TriMesh& original, const TriMesh& decoded, double* farthest) {
@@ -189,14 +153,14 @@ TEST(Draco, AGridThatJoinsCloseShellsIsRefined) {
   // coarsest grid: quantized, the sides coincide and the file fails its check; a finer grid keeps
   // them apart.
   TriMesh probe;
-  add_box(probe, {0, 0, 0}, {20, 30, 30});
+  test::append_box(probe, {0, 0, 0}, {20, 30, 30});
   const double bound = 0.05;
   const int bits = draco_quantization_bits(probe, bound);
   const double step = 30.0 / double((1 << bits) - 1);
   const double k = std::floor(10 / step);
   TriMesh boxes;
-  add_box(boxes, {0, 0, 0}, {(k + 0.1) * step, 30, 30});
-  add_box(boxes, {(k + 0.3) * step, 0, 0}, {20, 30, 30});
+  test::append_box(boxes, {0, 0, 0}, {(k + 0.1) * step, 30, 30});
+  test::append_box(boxes, {(k + 0.3) * step, 0, 0}, {20, 30, 30});
   ASSERT_TRUE(check_mesh(boxes).valid());
   ASSERT_EQ(draco_quantization_bits(boxes, bound), bits);
   TempDir dir;

@@ -14,49 +14,22 @@
 
 #include "errors.h"
 #include "pipeline/pipeline.h"
+#include "tests/mesh_fixtures.h"
 #include "tests/test_support.h"
 
 namespace lacuna {
 namespace {
 
 namespace fs = std::filesystem;
+using test::geodesic_sphere;
 using test::TempDir;
 using test::write_file;
 
 constexpr double kPi = 3.14159265358979323846;
 
-TriMesh geodesic_sphere(double r, int levels) {
-  TriMesh m;
-  m.positions_mm = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-  m.triangles = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
-  for (int l = 0; l < levels; ++l) {
-    std::map<std::pair<uint32_t, uint32_t>, uint32_t> middle;
-    auto mid = [&](uint32_t a, uint32_t b) {
-      auto key = std::minmax(a, b);
-      auto it = middle.find(key);
-      if (it != middle.end()) return it->second;
-      m.positions_mm.push_back((m.positions_mm[a] + m.positions_mm[b]) * 0.5);
-      return middle[key] = uint32_t(m.positions_mm.size() - 1);
-    };
-    std::vector<std::array<uint32_t, 3>> next;
-    for (auto [a, b, d] : m.triangles) {
-      const uint32_t ab = mid(a, b), bd = mid(b, d), da = mid(d, a);
-      next.insert(next.end(), {{a, ab, da}, {ab, b, bd}, {da, bd, d}, {ab, bd, da}});
-    }
-    m.triangles = std::move(next);
-  }
-  for (Vec3d& p : m.positions_mm) p = p * (r / norm(p));
-  return m;
-}
-
 TriMesh box(const Vec3d& lo, const Vec3d& hi) {
   TriMesh m;
-  for (int i = 0; i < 8; ++i) m.positions_mm.push_back({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
-  const uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  for (const auto& q : quads) {
-    m.triangles.push_back({q[0], q[1], q[2]});
-    m.triangles.push_back({q[0], q[2], q[3]});
-  }
+  test::append_box(m, lo, hi);
   return m;
 }
 
@@ -84,7 +57,7 @@ TEST(Render, SilhouettesHaveTheirProjectedArea) {
   options.width = 800;
   options.height = 800;
   options.views = {RenderView::kFront};
-  const Picture ball = render_mesh(geodesic_sphere(10, 5), options);
+  const Picture ball = render_mesh(geodesic_sphere({0, 0, 0}, 10, 5), options);
   const double ppm = ball.views[0].pixels_per_mm;
   EXPECT_NEAR(double(part_pixels(ball, 0)), kPi * 100 * ppm * ppm, 0.01 * kPi * 100 * ppm * ppm);
   options.views = {RenderView::kFront, RenderView::kTop};
@@ -122,7 +95,7 @@ TEST(Render, ScaleBarIsARoundLengthAtTheViewsScale) {
   options.width = 640;
   options.height = 480;
   options.views = {RenderView::kIso, RenderView::kFront, RenderView::kTop, RenderView::kSide};
-  const Picture p = render_mesh(geodesic_sphere(7, 3), options);
+  const Picture p = render_mesh(geodesic_sphere({0, 0, 0}, 7, 3), options);
   ASSERT_EQ(p.views.size(), 4u);
   for (const Picture::ViewInfo& v : p.views) {
     const double mantissa = v.bar_mm / std::pow(10.0, std::floor(std::log10(v.bar_mm)));
@@ -147,7 +120,7 @@ TEST(Render, MarkersAreDrawnWhereTheirPointsProject) {
   options.views = {RenderView::kTop};
   const Vec3d at{4, -3, 2};
   options.markers = {{RenderMarker::Kind::kTrappedVoid, at}};
-  const Picture p = render_mesh(geodesic_sphere(10, 3), options);
+  const Picture p = render_mesh(geodesic_sphere({0, 0, 0}, 10, 3), options);
   const Vec2d c = project_to_picture(p, 0, at);
   // Top view: x to the right, y up; the ball's centre is the drawing's centre.
   const Picture::ViewInfo& v = p.views[0];
@@ -160,7 +133,7 @@ TEST(Render, MarkersAreDrawnWhereTheirPointsProject) {
 }
 
 TEST(Render, FacesSeenFromBehindAreRed) {
-  TriMesh inside_out = geodesic_sphere(5, 3);
+  TriMesh inside_out = geodesic_sphere({0, 0, 0}, 5, 3);
   for (auto& t : inside_out.triangles) std::swap(t[1], t[2]);
   RenderOptions options;
   options.width = options.height = 300;
@@ -168,7 +141,7 @@ TEST(Render, FacesSeenFromBehindAreRed) {
   const Picture::ViewInfo& v = p.views[0];
   const auto centre = pixel(p, int(v.centre_x), int(v.centre_y));
   EXPECT_GT(int(centre[0]), int(centre[2]) + 50);
-  const Picture right = render_mesh(geodesic_sphere(5, 3), options);
+  const Picture right = render_mesh(geodesic_sphere({0, 0, 0}, 5, 3), options);
   const auto blue = pixel(right, int(v.centre_x), int(v.centre_y));
   EXPECT_GT(int(blue[2]), int(blue[0]));
 }
@@ -176,7 +149,7 @@ TEST(Render, FacesSeenFromBehindAreRed) {
 TEST(Render, SamePixelsForAnyThreadCount) {
   RenderOptions options;
   options.views = {RenderView::kIso, RenderView::kSide};
-  const TriMesh ball = geodesic_sphere(10, 5);
+  const TriMesh ball = geodesic_sphere({0, 0, 0}, 10, 5);
   Picture one, two;
   {
     tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
@@ -192,7 +165,7 @@ TEST(Render, SamePixelsForAnyThreadCount) {
 TEST(Render, BadSizesAndViewsAreRefused) {
   RenderOptions options;
   options.width = 10;
-  EXPECT_THROW(render_mesh(geodesic_sphere(1, 1), options), InvalidInput);
+  EXPECT_THROW(render_mesh(geodesic_sphere({0, 0, 0}, 1, 1), options), InvalidInput);
   EXPECT_THROW(render_view_from_name("back", "--views"), InvalidInput);
 }
 
@@ -211,7 +184,7 @@ TEST(Render, PngIsCompressedAndInflatesToThePixels) {
   RenderOptions options;
   options.width = 320;
   options.height = 200;
-  const Picture picture = render_mesh(geodesic_sphere(3, 3), options);
+  const Picture picture = render_mesh(geodesic_sphere({0, 0, 0}, 3, 3), options);
   TempDir dir;
   write_picture_png((dir / "p.png").string(), picture);
   const std::string png = test::read_file(dir / "p.png");

@@ -1,11 +1,12 @@
 #include "pipeline/draco_output.h"
 
-#include <cstdio>
-#include <memory>
+
+#include <algorithm>
 
 #include "errors.h"
 #include "export/draco.h"
 #include "export/mesh_io.h"
+#include "export/output_files.h"
 
 namespace lacuna {
 
@@ -20,15 +21,7 @@ DracoOutput write_checked_draco(const std::string& path, const TriMesh& mesh, do
   out.figures.binary_stl_bytes = 84 + 50 * uint64_t(mesh.triangles.size());
   for (int bits = coarsest;; bits = std::min(bits + 2, kMaxDracoBits)) {
     const std::string bytes = encode_draco(mesh, bits);
-    {
-      struct Closer {
-        void operator()(std::FILE* f) const { std::fclose(f); }
-      };
-      std::unique_ptr<std::FILE, Closer> file(std::fopen(path.c_str(), "wb"));
-      if (!file || std::fwrite(bytes.data(), 1, bytes.size(), file.get()) != bytes.size() ||
-          std::fclose(file.release()) != 0)
-        throw IoError("cannot write '" + path + "'");
-    }
+    write_whole_file(path, bytes);
     ReadOptions read;
     read.max_memory_bytes = max_memory_bytes;
     const TriMesh back = read_mesh(path, MeshFormat::kDrc, read);

@@ -36,15 +36,15 @@ struct ObjectMesh {
 // (InvalidInput, IoError, ResourceLimit before allocating beyond the budget, Cancelled).
 Volume evaluate_object(const Recipe& recipe, const std::string& object, const ObjectOptions& options = {});
 
-// The surface of a level set simplified to `simplify_mm` (0: the plain marching-tetrahedra surface),
-// with cavities and specks of less than a voxel's volume removed. Throws ResourceLimit before meshing
-// when the mesh would not fit `max_memory_bytes` (0: half the memory available), InvalidInput when
-// nothing is left; `what` names the object in messages.
 // The surface of `volume`: marching tetrahedra, simplified block by block to simplify_mm when it
 // is > 0, with sub-voxel cavities filled and specks removed. No memory check and no check for an
 // empty result: the callers say what they mesh.
 ObjectMesh extract_object_surface(const Volume& volume, double simplify_mm);
 
+// The surface of a level set simplified to `simplify_mm` (0: the plain marching-tetrahedra surface),
+// with cavities and specks of less than a voxel's volume removed. Throws ResourceLimit before meshing
+// when the mesh would not fit `max_memory_bytes` (0: half the memory available), InvalidInput when
+// nothing is left; `what` names the object in messages.
 ObjectMesh mesh_volume(const Volume& volume, double simplify_mm, const std::string& what,
                        uint64_t max_memory_bytes = 0);
 
