@@ -11,6 +11,7 @@
 #include <limits>
 
 #include "bcifs/realize.h"
+#include "export/output_files.h"
 #include "errors.h"
 
 namespace lacuna {
@@ -324,8 +325,13 @@ Picture render_mesh(const TriMesh& mesh, const RenderOptions& options) {
   return picture;
 }
 
+std::string encode_picture_png(const Picture& picture) {
+  const std::vector<uint8_t> png = bcifs::encode_png(picture.width, picture.height, picture.rgb, 6);
+  return std::string(png.begin(), png.end());
+}
+
 void write_picture_png(const std::string& path, const Picture& picture) {
-  bcifs::write_png(path, picture.width, picture.height, picture.rgb, 6);
+  write_whole_file(path, encode_picture_png(picture));
 }
 
 }  // namespace lacuna

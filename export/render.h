@@ -58,6 +58,9 @@ Vec2d project_to_picture(const Picture& picture, size_t view, const Vec3d& point
 // background with the title. Identical pixels for any thread count.
 Picture render_mesh(const TriMesh& mesh, const RenderOptions& options);
 
+// The picture as an 8-bit RGB PNG file's bytes.
+std::string encode_picture_png(const Picture& picture);
+
 // Writes the picture as an 8-bit RGB PNG (IoError on failure).
 void write_picture_png(const std::string& path, const Picture& picture);
 

@@ -5,7 +5,7 @@
 #   scripts/setup.sh                      install and build
 #   scripts/setup.sh --run RECIPE [ARGS]  ... then `lacuna run RECIPE ARGS`
 #   scripts/setup.sh --test               ... with the test clients (PrusaSlicer, admesh, Gmsh, CalculiX, Draco's
-#                                         reference decoder, pytest, meshio) and clang (scripts/fuzz.sh),
+#                                         reference decoder, pytest, meshio, Chromium, PIL) and clang (scripts/fuzz.sh),
 #                                         warnings as errors, then the whole test suite through CTest
 #
 # The Python module is built for Debian's /usr/bin/python3 (where python3-numpy lives), whatever
@@ -30,8 +30,13 @@ packages=(build-essential cmake ninja-build ccache pkg-config
           python3-dev pybind11-dev python3-numpy)
 if [ "$mode" = test ]; then
   # Real downstream clients the tests run the outputs through.
-  packages+=(prusa-slicer admesh gmsh calculix-ccx draco python3-pytest python3-meshio clang libclang-rt-14-dev)
+  packages+=(prusa-slicer admesh gmsh calculix-ccx draco python3-pytest python3-meshio clang libclang-rt-14-dev
+             chromium python3-pil)
 fi
+
+# report.html's viewer is bundled from npm packages at build time: Node.js and npm from Debian,
+# unless a node and npm are on PATH already.
+command -v node >/dev/null && command -v npm >/dev/null || packages+=(nodejs npm)
 
 missing=()
 for p in "${packages[@]}"; do
@@ -44,6 +49,13 @@ if [ "${#missing[@]}" -gt 0 ]; then
   export DEBIAN_FRONTEND=noninteractive
   $sudo apt-get update -q
   $sudo apt-get install -y -q --no-install-recommends "${missing[@]}"
+fi
+
+# three.js and esbuild (and playwright-core for the browser tests), as pinned by the lock file.
+if [ ! -f export/viewer/node_modules/.package-lock.json ] ||
+   ! cmp -s export/viewer/package-lock.json export/viewer/node_modules/.lacuna-lock; then
+  echo "setup: installing export/viewer's npm packages" >&2
+  (cd export/viewer && npm ci --no-audit --no-fund --loglevel=error && cp package-lock.json node_modules/.lacuna-lock)
 fi
 
 build_dir=build

@@ -101,6 +101,7 @@ TEST(Pipeline, RunReportsEveryStageToTheSinkAndTheReportIsTheFileWritten) {
   ASSERT_EQ(report.outputs.size(), 1u);
   EXPECT_TRUE(report.outputs[0].valid());
   EXPECT_EQ(report.written, (std::vector<std::string>{(dir.path() / "out" / "ball.stl").string(),
+                                                      (dir.path() / "out" / "report.html").string(),
                                                       (dir.path() / "out" / "report.json").string()}));
   // Every stage that began ended; the sphere was rasterized, meshed and its file checked.
   EXPECT_EQ(sink.ends, sink.stages.size());

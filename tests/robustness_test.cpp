@@ -416,7 +416,7 @@ TEST(Robustness, TemporariesOfDeadProcessesAreRemovedAtStart) {
   write_file(dir / "out" / "notes.txt", "mine");
   Result r = lacuna("run " + quote((dir / "s.json").string()) + " -o " + quote((dir / "out").string()), dir.path());
   EXPECT_EQ(r.code, 0) << r.err;
-  EXPECT_EQ(entries(dir / "out"), (std::vector<std::string>{alive, "notes.txt", "report.json", "s.stl"}));
+  EXPECT_EQ(entries(dir / "out"), (std::vector<std::string>{alive, "notes.txt", "report.html", "report.json", "s.stl"}));
 }
 
 TEST(Robustness, ABusyOutputFolderIsRefusedClearly) {
@@ -437,7 +437,7 @@ TEST(Robustness, ABusyOutputFolderIsRefusedClearly) {
   ::close(fd);
   Result free = lacuna("run " + quote((dir / "s.json").string()) + " -o " + quote((dir / "out").string()), dir.path());
   EXPECT_EQ(free.code, 0) << free.err;
-  EXPECT_EQ(entries(dir / "out"), (std::vector<std::string>{"report.json", "s.stl"}));
+  EXPECT_EQ(entries(dir / "out"), (std::vector<std::string>{"report.html", "report.json", "s.stl"}));
 }
 
 TEST(Robustness, TwoRunsIntoOneFolderLeaveAConsistentReport) {
@@ -463,7 +463,7 @@ TEST(Robustness, TwoRunsIntoOneFolderLeaveAConsistentReport) {
       }
     }
     EXPECT_TRUE(ca == 0 || cb == 0);
-    // report.json describes files that are there, as they are; no lock or temporary is left.
+    // report.json (and report.html) describes files that are there, as they are; no lock or temporary is left.
     const nlohmann::json report = nlohmann::json::parse(read_file(dir / "out/report.json"));
     for (const auto& o : report["outputs"]) {
       const std::string file = o["file"].get<std::string>();
@@ -471,7 +471,7 @@ TEST(Robustness, TwoRunsIntoOneFolderLeaveAConsistentReport) {
       EXPECT_EQ(fs::file_size(file), 84 + 50 * o["triangles"].get<uint64_t>()) << file;
     }
     const std::vector<std::string> names = entries(dir / "out");
-    EXPECT_EQ(names.size(), 1 + size_t(ca == 0) + size_t(cb == 0));
+    EXPECT_EQ(names.size(), 2 + size_t(ca == 0) + size_t(cb == 0));
     for (const std::string& name : names) EXPECT_NE(name[0], '.') << name;
   }
 }

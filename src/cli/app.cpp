@@ -75,7 +75,12 @@ int command_run(const std::string& recipe, const RunOptions& options, const Comm
                     out["components"].get<uint64_t>() == 1 ? "" : "s", (long long)out["genus"].get<int64_t>());
       if (out.contains("picture")) std::printf("  wrote %s  (picture)\n", out["picture"].get<std::string>().c_str());
     }
-    if (options.write_report) std::printf("  wrote %s\n", result.written.back().c_str());
+    if (options.write_report) {
+      // written ends with report.html, report.json.
+      std::printf("  wrote %s\n", result.written.back().c_str());
+      std::printf("  wrote %s  (open it in a browser: each object in 3D, its checks and figures)\n",
+                  result.written[result.written.size() - 2].c_str());
+    }
   }
   return kExitOk;
 }

@@ -16,6 +16,7 @@
 #include "errors.h"
 #include "pipeline/build_inputs.h"
 #include "pipeline/generators.h"
+#include "pipeline/input_figures.h"
 #include "recipe/input_parsers.h"
 #include "recipe/json_fields.h"
 
@@ -77,16 +78,6 @@ std::pair<int, int> parse_levels(const std::string& text) {
   return {lo, hi};
 }
 
-// Rows bottom-up (the raster) to top-down (PNG).
-std::vector<uint8_t> flip_rows(const std::vector<uint8_t>& rgb, int width, int height) {
-  std::vector<uint8_t> out(rgb.size());
-  const size_t row = size_t(3 * width);
-  for (int y = 0; y < height; ++y)
-    std::copy(rgb.begin() + long(size_t(y) * row), rgb.begin() + long(size_t(y + 1) * row),
-              out.begin() + long(size_t(height - 1 - y) * row));
-  return out;
-}
-
 int bcifs_measure(const BcifsArgs& a) {
   const auto [lo, hi] = parse_levels(a.levels);
   const nlohmann::json top = read_json_file(a.recipe, "a recipe file (.json)");
@@ -111,7 +102,6 @@ int bcifs_measure(const BcifsArgs& a) {
     }
     entry["topology"] = faces;
     const bcifs::GeometricMeasures& m = measures.geometry;
-    const std::vector<std::vector<Vec2d>>& top_polygons = measures.polygons;
     const bcifs::BoxCount& region = measures.region;
     const bcifs::BoxCount& boundary = measures.boundary;
     entry["levels"] = {lo, hi};
@@ -124,14 +114,11 @@ int bcifs_measure(const BcifsArgs& a) {
                              {"log_inverse_size", boundary.log_inverse_size},
                              {"boundary_log_count", boundary.log_count},
                              {"region_log_count", region.log_count}};
-    bcifs::Raster raster = bcifs::square_raster(top_polygons, 1024);
-    bcifs::rasterize(top_polygons, raster);
-    const std::vector<uint8_t> mask = bcifs::mask_of(raster);
-    const auto density = bcifs::density_colours(bcifs::density_map(mask, 1024, 1024, a.mask_px));
+    PlateImages drawn = plate_images(measures, a.mask_px);
     const std::string density_file = (out_dir / (name + "_density.png")).string();
     const std::string plot_file = (out_dir / (name + "_plot.png")).string();
-    images.push_back({density_file, bcifs::encode_png(1024, 1024, flip_rows(density, 1024, 1024))});
-    images.push_back({plot_file, bcifs::encode_png(800, 400, bcifs::plot_measures(m, boundary, 800, 400))});
+    images.push_back({density_file, std::move(drawn.density_png)});
+    images.push_back({plot_file, std::move(drawn.plot_png)});
     entry["density_map"] = density_file;
     entry["mask_px"] = a.mask_px;
     entry["plot"] = plot_file;

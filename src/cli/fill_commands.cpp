@@ -71,44 +71,6 @@ fill::BoundaryPolicy policy_of(const std::string& name) {
   throw InvalidInput("--policy: expected allow, reject or snap, got \"" + name + "\"");
 }
 
-// The replicated pattern over cells x cells unit cells, the fundamental region outlined.
-std::string svg_picture(const fill::WallpaperFill& pattern, int cells) {
-  const std::vector<fill::Placement2> all = fill::replicate(pattern, cells, cells);
-  const fill::Lattice& l = pattern.lattice;
-  Vec2d lo{HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL};
-  for (const Vec2d& q : {Vec2d{0, 0}, l.a * double(cells), l.b * double(cells), (l.a + l.b) * double(cells)}) {
-    lo = Vec2d{std::min(lo.x, q.x), std::min(lo.y, q.y)};
-    hi = Vec2d{std::max(hi.x, q.x), std::max(hi.y, q.y)};
-  }
-  char buf[256];
-  std::ostringstream s;
-  std::snprintf(buf, sizeof buf,
-                "<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"%.6g %.6g %.6g %.6g\" width=\"800\">\n", lo.x,
-                -hi.y, hi.x - lo.x, hi.y - lo.y);
-  s << buf << "<g transform=\"scale(1,-1)\">\n";
-  for (const fill::Placement2& p : all) {
-    if (pattern.motif.kind == fill::Motif2::Kind::kCircle) {
-      std::snprintf(buf, sizeof buf, "<circle cx=\"%.9g\" cy=\"%.9g\" r=\"%.9g\" fill=\"black\"/>\n", p.center_mm.x,
-                    p.center_mm.y, p.scale / std::sqrt(3.14159265358979323846));
-      s << buf;
-      continue;
-    }
-    s << "<polygon fill=\"black\" points=\"";
-    for (const Vec2d& q : fill::placed_outline(pattern.motif, p)) {
-      std::snprintf(buf, sizeof buf, "%.9g,%.9g ", q.x, q.y);
-      s << buf;
-    }
-    s << "\"/>\n";
-  }
-  s << "<polygon fill=\"none\" stroke=\"red\" stroke-width=\"" << 0.002 * (hi.x - lo.x) << "\" points=\"";
-  for (const Vec2d& q : fill::fundamental_region_mm(pattern.group, l)) {
-    std::snprintf(buf, sizeof buf, "%.9g,%.9g ", q.x, q.y);
-    s << buf;
-  }
-  s << "\"/>\n</g>\n</svg>\n";
-  return s.str();
-}
-
 int fill_pattern(const FillArgs& args) {
   fill::Group group{};
   try {
@@ -132,7 +94,7 @@ int fill_pattern(const FillArgs& args) {
     {
       std::ofstream out(temporary, std::ios::binary);
       if (!out) throw IoError(args.svg + ": cannot write the picture");
-      out << svg_picture(pattern, args.cells);
+      out << fill::wallpaper_svg(pattern, args.cells);
       if (!out.flush()) throw IoError(args.svg + ": cannot write the picture");
     }
     std::filesystem::rename(temporary, target);

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <sstream>
 #include <string>
 #include <utility>
 
@@ -466,6 +468,43 @@ std::vector<Placement2> replicate(const WallpaperFill& fill, int cells_u, int ce
     }
   }
   return out;
+}
+
+std::string wallpaper_svg(const WallpaperFill& pattern, int cells) {
+  const std::vector<Placement2> all = replicate(pattern, cells, cells);
+  const Lattice& l = pattern.lattice;
+  Vec2d lo{HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL};
+  for (const Vec2d& q : {Vec2d{0, 0}, l.a * double(cells), l.b * double(cells), (l.a + l.b) * double(cells)}) {
+    lo = Vec2d{std::min(lo.x, q.x), std::min(lo.y, q.y)};
+    hi = Vec2d{std::max(hi.x, q.x), std::max(hi.y, q.y)};
+  }
+  char buf[256];
+  std::ostringstream s;
+  std::snprintf(buf, sizeof buf,
+                "<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"%.6g %.6g %.6g %.6g\" width=\"800\">\n", lo.x,
+                -hi.y, hi.x - lo.x, hi.y - lo.y);
+  s << buf << "<g transform=\"scale(1,-1)\">\n";
+  for (const Placement2& p : all) {
+    if (pattern.motif.kind == Motif2::Kind::kCircle) {
+      std::snprintf(buf, sizeof buf, "<circle cx=\"%.9g\" cy=\"%.9g\" r=\"%.9g\" fill=\"black\"/>\n", p.center_mm.x,
+                    p.center_mm.y, p.scale / std::sqrt(3.14159265358979323846));
+      s << buf;
+      continue;
+    }
+    s << "<polygon fill=\"black\" points=\"";
+    for (const Vec2d& q : placed_outline(pattern.motif, p)) {
+      std::snprintf(buf, sizeof buf, "%.9g,%.9g ", q.x, q.y);
+      s << buf;
+    }
+    s << "\"/>\n";
+  }
+  s << "<polygon fill=\"none\" stroke=\"red\" stroke-width=\"" << 0.002 * (hi.x - lo.x) << "\" points=\"";
+  for (const Vec2d& q : fundamental_region_mm(pattern.group, l)) {
+    std::snprintf(buf, sizeof buf, "%.9g,%.9g ", q.x, q.y);
+    s << buf;
+  }
+  s << "\"/>\n</g>\n</svg>\n";
+  return s.str();
 }
 
 }  // namespace fill

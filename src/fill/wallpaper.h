@@ -87,5 +87,9 @@ WallpaperFill fill_wallpaper(Group group, const Lattice& lattice, const Motif2& 
 // InvalidInput unless both counts are >= 1, ResourceLimit past 100 000 000 placements.
 std::vector<Placement2> replicate(const WallpaperFill& fill, int cells_u, int cells_v);
 
+// The pattern replicated over cells x cells unit cells as an SVG picture (motifs black, y up), the
+// fundamental region outlined in red. Throws as replicate().
+std::string wallpaper_svg(const WallpaperFill& pattern, int cells);
+
 }  // namespace fill
 }  // namespace lacuna

@@ -304,6 +304,7 @@ class Builder {
           fail("wallpaper", e.what());
         }
         placements = fill::replicate(pattern, f.cells_u, f.cells_v);
+        out_.pattern = std::make_shared<const fill::WallpaperFill>(pattern);
         out_.report = MotifFillReport{placements.size(), pattern.fundamental.motifs.size(), pattern.fundamental.fill_fraction,
                                       pattern.fundamental.stop_reason};
         if (f.wrap_depth_mm > 0) {
@@ -519,6 +520,7 @@ class Builder {
     report.face_types = plate.rules.rules.size();
     report.loops = region.loops_mm.size();
     out_.report = report;
+    out_.plate = std::make_shared<const bcifs::Plate>(plate);
     out_.geometry.regions.push_back(std::move(region));
   }
 

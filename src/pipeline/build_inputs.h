@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -14,10 +15,18 @@
 
 namespace lacuna {
 
+namespace fill {
+struct WallpaperFill;
+}
+
 // An input built: its geometry and what building it found.
 struct BuiltInput {
   GeometrySet geometry;
   InputReport report;
+  // What the report page draws of it (pipeline/input_figures.h): a lacunar plate's rule set and
+  // realization, a wallpaper pattern's fundamental region.
+  std::shared_ptr<const bcifs::Plate> plate;
+  std::shared_ptr<const fill::WallpaperFill> pattern;
 };
 
 // Every input of a recipe built, in the recipe's order.

@@ -32,7 +32,7 @@ struct RunOptions {
   uint64_t max_memory_bytes = 0;     // 0: half the memory available to the process
   int threads = 0;                   // worker threads for the call; 0: every core
   ProgressSink* progress = nullptr;  // receives the stages and may cancel them; null: the one current on this thread
-  bool write_report = true;          // report.json next to the outputs
+  bool write_report = true;          // report.json and report.html next to the outputs
 };
 
 // Runs the recipe at `recipe_path`: reads it, builds its inputs, refuses what would not fit the

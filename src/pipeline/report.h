@@ -138,7 +138,7 @@ struct RunReport {
   uint64_t memory_budget_bytes = 0;
   size_t threads = 0;
   std::vector<std::pair<std::string, InputReport>> inputs;  // by input name, those with something to report
-  std::vector<std::string> written;  // final paths of every file written, report.json last; empty when invalid
+  std::vector<std::string> written;  // final paths of every file written, report.html then report.json last; empty when invalid
 };
 
 // The JSON of an input's report (null when there is nothing to report).

@@ -14,9 +14,12 @@
 #include "export/fea.h"
 #include "export/mesh_io.h"
 #include "export/output_files.h"
+#include "export/draco.h"
+#include "export/report_page.h"
 #include "pipeline/detail/memory.h"
 #include "pipeline/draco_output.h"
 #include "pipeline/fea_output.h"
+#include "pipeline/input_figures.h"
 #include "pipeline/mesh_object.h"
 #include "pipeline/render_output.h"
 #include "solids/check.h"
@@ -113,6 +116,32 @@ ThreeMfInfo package_info(const Recipe& recipe) {
   throw Error(message);
 }
 
+// The object's surface on report.html: as Draco at the grid the .drc outputs get by default (no
+// vertex moves more than a tenth of a voxel), with its printability findings as markers; objects
+// too large for a page are listed without a view.
+void add_page_mesh(ReportPage& page, const Recipe& recipe, const std::string& object, const TriMesh& mesh,
+                   const std::optional<PrintabilityFindings>& printability, double voxel_size_mm) {
+  PageMesh m;
+  m.object = object;
+  for (const RecipeOutput& out : recipe.outputs)
+    if (out.object == object || std::find(out.group.begin(), out.group.end(), object) != out.group.end())
+      m.outputs.push_back(out.file);
+  if (mesh.triangles.size() > kPageMaxTriangles) {
+    page.skipped.push_back({object, std::to_string(mesh.triangles.size()) + " triangles, more than a page shows (" +
+                                        std::to_string(kPageMaxTriangles) + "); open its files instead"});
+    return;
+  }
+  int bits = draco_quantization_bits(mesh, voxel_size_mm / 10);
+  m.draco = encode_draco(mesh, bits > 0 ? bits : kMaxDracoBits);
+  if (printability) {
+    for (const auto& [kind, features] : {std::pair{"trapped_voids", &printability->trapped_voids},
+                                         std::pair{"thin_walls", &printability->thin_walls},
+                                         std::pair{"small_holes", &printability->small_holes}})
+      for (const PrintFeature& f : *features) m.markers.push_back({kind, f.location_mm});
+  }
+  page.meshes.push_back(std::move(m));
+}
+
 }  // namespace
 
 std::string output_folder(const Recipe& recipe, const WriteOptions& options) {
@@ -146,6 +175,8 @@ RunReport write_outputs(const Recipe& recipe, const Plan& plan, Evaluation&& eva
   OutputTransaction transaction;
   RunReport report;
   StageTimer timer;
+  ReportPage page;  // report.html: the objects as Draco, the pictures
+  page.build_direction = recipe.printability.build_direction;
   try {
     // Each exported object is meshed once and written in every format asked for; then every
     // written file is read back and checked as the file it is.
@@ -181,6 +212,10 @@ RunReport write_outputs(const Recipe& recipe, const Plan& plan, Evaluation&& eva
           throw InvalidInput(recipe.file + ": \"" + object + "\" is empty: nothing is left to export");
       }
       volume = Volume();
+      if (options.write_report) {
+        timer.start("report");
+        add_page_mesh(page, recipe, object, surfaces.begin()->second.mesh, printability, vopt.voxel_size_mm);
+      }
       auto surface_for = [&](const RecipeOutput& out) -> const ObjectMesh& {
         return surfaces.at(simplify_deviation_mm(recipe, out));
       };
@@ -224,7 +259,9 @@ RunReport write_outputs(const Recipe& recipe, const Plan& plan, Evaluation&& eva
           picture.markers = printability_markers(printability->trapped_voids, printability->thin_walls,
                                                  printability->small_holes);
         const std::string path = (out_dir / out.render->file).string();
-        write_picture_png(transaction.stage(path), render_mesh(surface_for(out).mesh, picture));
+        const std::string png = encode_picture_png(render_mesh(surface_for(out).mesh, picture));
+        write_whole_file(transaction.stage(path), png);
+        if (options.write_report) page.pictures.push_back({out.render->file + " (" + object + ")", "image/png", png});
       }
       for (const RecipeOutput& out : recipe.outputs) {
         if (!out.group.empty()) {
@@ -330,15 +367,27 @@ RunReport write_outputs(const Recipe& recipe, const Plan& plan, Evaluation&& eva
       return report;
     }
     const std::string report_path = (out_dir / "report.json").string();
-    if (options.write_report)
-      write_text_file_atomically(transaction.stage(report_path), to_json(report).dump(2) + "\n");
+    const std::string page_path = (out_dir / "report.html").string();
+    if (options.write_report) {
+      timer.start("report");
+      for (InputFigure& f : input_figures(inputs))
+        page.pictures.push_back({std::move(f.caption), std::move(f.type), std::move(f.bytes)});
+      timer.stop();
+      report.stage_seconds.push_back(timer.seconds().back());
+      const nlohmann::json report_json = to_json(report);
+      write_text_file_atomically(transaction.stage(report_path), report_json.dump(2) + "\n");
+      write_whole_file(transaction.stage(page_path), report_page_html(report_json, page));
+    }
     transaction.commit();
     folder.keep();
     for (const OutputReport& o : report.outputs) {
       report.written.push_back(o.file);
       if (!o.picture.empty()) report.written.push_back(o.picture);
     }
-    if (options.write_report) report.written.push_back(report_path);
+    if (options.write_report) {
+      report.written.push_back(page_path);
+      report.written.push_back(report_path);
+    }
     return report;
   } catch (const Error& e) {
     transaction.rollback();

@@ -19,7 +19,7 @@ namespace lacuna {
 struct WriteOptions {
   std::string output_dir;            // empty: "<recipe name>-out" in the working folder
   OutputFolder* folder = nullptr;    // the output folder, already held (created, locked); null: held here
-  bool write_report = true;          // report.json next to the outputs
+  bool write_report = true;          // report.json and report.html next to the outputs
   ProgressSink* progress = nullptr;  // null: the sink current on this thread
 };
 

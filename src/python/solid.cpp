@@ -525,7 +525,7 @@ void add_solids(py::module_& m) {
   py::class_<RunResult>(m, "RunResult", "What lacuna.run() did: the report and the meshes it wrote.")
       .def_readonly("report", &RunResult::report, "The report as a dict: what report.json holds.")
       .def_property_readonly(
-          "files", [](const RunResult& r) { return r.report["written"]; }, "Every file written, report.json last.")
+          "files", [](const RunResult& r) { return r.report["written"]; }, "Every file written, report.html then report.json last.")
       .def_property_readonly(
           "meshes",
           [](RunResult& r) {
@@ -581,7 +581,8 @@ void add_solids(py::module_& m) {
       py::arg("max_memory_gb") = py::none(), py::arg("threads") = py::none(), py::arg("simplify_mm") = py::none(),
       py::arg("write_report") = true,
       "Runs a recipe (a path, JSON text or a dict) as `lacuna run` does: every output written under a temporary name, "
-      "read back and checked, then all renamed into output_dir (default <name>-out) with report.json, or nothing. "
+      "read back and checked, then all renamed into output_dir (default <name>-out) with report.json and report.html "
+      "(unless write_report is False), or nothing. "
       "voxel_size_mm (mm) and simplify_mm (mm) override the recipe's, max_memory_gb is the budget (GB, 10^9 bytes; "
       "None: half the machine's), threads the worker threads (None: every core). Returns a RunResult (report dict and "
       "meshes); raises CheckFailedError (with .report) when an output fails its checks, ResourceLimitError beyond "

@@ -129,4 +129,4 @@ def test_a_run_after_one_killed_by_sigterm_removes_its_leftovers(tmp_path):
     dead.wait()
     (out / f".s.stl.tmp-{dead.pid}-0").write_text("partial")
     lacuna.run(lacuna.sphere(radius_mm=1).to_recipe(name="s", voxel_size_mm=0.2), output_dir=out)
-    assert sorted(p.name for p in out.iterdir()) == ["report.json", "s.stl"]
+    assert sorted(p.name for p in out.iterdir()) == ["report.html", "report.json", "s.stl"]

@@ -37,7 +37,7 @@ def test_run_gives_the_command_line_report(tmp_path, cli):
     result = lacuna.run(path, output_dir=tmp_path / "py")
     assert result.report["valid"] is True
     assert without_times(result.report) == without_times(expected)
-    assert sorted(os.listdir(tmp_path / "py")) == ["cut.3mf", "cut.stl", "report.json"]
+    assert sorted(os.listdir(tmp_path / "py")) == ["cut.3mf", "cut.stl", "report.html", "report.json"]
     assert (tmp_path / "py" / "cut.stl").read_bytes() == (tmp_path / "cli" / "cut.stl").read_bytes()
     meshes = result.meshes
     assert sorted(meshes) == ["cut.3mf", "cut.stl"]
@@ -53,7 +53,7 @@ def test_draco_outputs_and_pictures(tmp_path):
     entry = result.report["outputs"][0]
     assert entry["draco"]["file_bytes"] == (tmp_path / "out" / "cut.drc").stat().st_size
     assert entry["picture"] == str(tmp_path / "out" / "cut.png")
-    assert result.files == [str(tmp_path / "out" / n) for n in ("cut.drc", "cut.png", "report.json")]
+    assert result.files == [str(tmp_path / "out" / n) for n in ("cut.drc", "cut.png", "report.html", "report.json")]
     back = result.meshes["cut.drc"]
     assert back.faces.shape[0] == entry["triangles"] and back.genus == entry["genus"] == 1
     assert back.volume_mm3 == pytest.approx(entry["volume_mm3"], rel=1e-9)

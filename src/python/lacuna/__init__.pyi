@@ -191,7 +191,7 @@ def voxelize(
     """The level set of one object of a recipe (default: its first output's)."""
 
 def read_mesh(path: _Path) -> Mesh:
-    """Reads STL, OBJ, PLY or 3MF."""
+    """Reads STL, OBJ, PLY, 3MF or Draco (.drc)."""
 
 def input_types() -> List[str]: ...
 def solid(type: str, **keys: Any) -> Solid:

@@ -1,0 +1,58 @@
+#include "pipeline/input_figures.h"
+
+#include <algorithm>
+
+#include "bcifs/realize.h"
+#include "fill/wallpaper.h"
+
+namespace lacuna {
+namespace {
+
+// Rows bottom-up (the raster) to top-down (PNG).
+std::vector<uint8_t> flip_rows(const std::vector<uint8_t>& rgb, int width, int height) {
+  std::vector<uint8_t> out(rgb.size());
+  const size_t row = size_t(3 * width);
+  for (int y = 0; y < height; ++y)
+    std::copy(rgb.begin() + long(size_t(y) * row), rgb.begin() + long(size_t(y + 1) * row),
+              out.begin() + long(size_t(height - 1 - y) * row));
+  return out;
+}
+
+std::string as_string(const std::vector<uint8_t>& bytes) { return std::string(bytes.begin(), bytes.end()); }
+
+}  // namespace
+
+PlateImages plate_images(const PlateMeasures& measures, int mask_px) {
+  constexpr int kSide = 1024;
+  bcifs::Raster raster = bcifs::square_raster(measures.polygons, kSide);
+  bcifs::rasterize(measures.polygons, raster);
+  const std::vector<uint8_t> mask = bcifs::mask_of(raster);
+  const std::vector<uint8_t> density = bcifs::density_colours(bcifs::density_map(mask, kSide, kSide, mask_px));
+  PlateImages images;
+  images.density_png = bcifs::encode_png(kSide, kSide, flip_rows(density, kSide, kSide), 6);
+  images.plot_png = bcifs::encode_png(800, 400, bcifs::plot_measures(measures.geometry, measures.boundary, 800, 400), 6);
+  return images;
+}
+
+std::vector<InputFigure> input_figures(const BuiltInputs& inputs) {
+  std::vector<InputFigure> figures;
+  for (size_t i = 0; i < inputs.names.size(); ++i) {
+    const std::string& name = inputs.names[i];
+    const BuiltInput& input = inputs.inputs[i];
+    if (input.plate) {
+      const int level = std::min(input.plate->options.level, 8);
+      const PlateImages images = plate_images(measure_plate(*input.plate, 0, level));
+      const std::string levels = "levels 0 to " + std::to_string(level);
+      figures.push_back({name + ": density at level " + std::to_string(level) + " (windows of 31 of 1024 pixels)",
+                         "image/png", as_string(images.density_png)});
+      figures.push_back({name + ": area and perimeter, box counting (" + levels + ")", "image/png",
+                         as_string(images.plot_png)});
+    }
+    if (input.pattern)
+      figures.push_back({name + ": the wallpaper pattern over 3 x 3 cells, its fundamental region in red",
+                         "image/svg+xml", fill::wallpaper_svg(*input.pattern, 3)});
+  }
+  return figures;
+}
+
+}  // namespace lacuna
