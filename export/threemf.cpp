@@ -21,6 +21,7 @@
 #include "Model/COM/NMR_DLLInterfaces.h"
 #include "errors.h"
 #include "export/mesh_io.h"
+#include "export/zip_archive.h"
 
 namespace lacuna {
 namespace {
@@ -760,46 +761,9 @@ void write_3mf(const std::string& path, const std::vector<ThreeMfObject>& parts,
 
   // The package is made in memory (entries with a fixed date, so identical meshes give identical
   // bytes), then written to the file, every write checked; a partial file is removed.
-  zip_error_t error;
-  zip_error_init(&error);
-  zip_source_t* buffer = zip_source_buffer_create(nullptr, 0, 0, &error);
-  if (!buffer) throw ResourceLimit(where + ": out of memory for the package");
-  zip_source_keep(buffer);
-  std::unique_ptr<zip_source_t, void (*)(zip_source_t*)> owned(buffer, zip_source_free);
-  zip_t* archive = zip_open_from_source(buffer, ZIP_TRUNCATE, &error);
-  if (!archive) throw IoError(where + ": " + zip_error_strerror(&error));
-  auto fail = [&](const std::string& what) {
-    const std::string message = what + ": " + zip_strerror(archive);
-    zip_discard(archive);
-    throw IoError(where + ": " + message);
-  };
-  const std::pair<const char*, const std::string*> entries[] = {
-      {"3D/3dmodel.model", &model}, {"[Content_Types].xml", &kContentTypes}, {"_rels/.rels", &kRelationships}};
-  for (const auto& [name, text] : entries) {
-    zip_source_t* source = zip_source_buffer(archive, text->data(), text->size(), 0);
-    if (!source) fail(cat("cannot add ", name));
-    const zip_int64_t index = zip_file_add(archive, name, source, ZIP_FL_ENC_UTF_8);
-    if (index < 0) {
-      zip_source_free(source);
-      fail(cat("cannot add ", name));
-    }
-    if (zip_set_file_compression(archive, zip_uint64_t(index), ZIP_CM_DEFLATE, 6) != 0 ||
-        zip_file_set_dostime(archive, zip_uint64_t(index), 0, 0, 0) != 0)
-      fail(cat("cannot set up ", name));
-  }
-  if (zip_close(archive) != 0) fail("cannot make the package");
-  std::vector<unsigned char> bytes;
-  if (zip_source_open(buffer) != 0 || zip_source_seek(buffer, 0, SEEK_END) != 0)
-    throw IoError(where + ": cannot read the package back");
-  const zip_int64_t size = zip_source_tell(buffer);
-  bytes.resize(size_t(std::max<zip_int64_t>(size, 0)));
-  if (size < 0 || zip_source_seek(buffer, 0, SEEK_SET) != 0 ||
-      zip_source_read(buffer, bytes.data(), zip_uint64_t(bytes.size())) != size) {
-    zip_source_close(buffer);
-    throw IoError(where + ": cannot read the package back");
-  }
-  zip_source_close(buffer);
-
+  const std::string bytes = zip_archive({{"3D/3dmodel.model", model}, {"[Content_Types].xml", kContentTypes},
+                                         {"_rels/.rels", kRelationships}},
+                                        where);
   std::FILE* file = std::fopen(path.c_str(), "wb");
   if (!file) throw IoError(cat("cannot create '", path, "': ", std::strerror(errno)));
   bool written = std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size();

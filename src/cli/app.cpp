@@ -30,6 +30,7 @@
 #include "export/report.h"
 #include "pipeline/pipeline.h"
 #include "pipeline/render_output.h"
+#include "pipeline/slice_output.h"
 #include "util/progress.h"
 #include "util/system.h"
 
@@ -174,6 +175,36 @@ int command_render(const RenderArgs& args, const RunOptions& base, const CommonF
     std::printf("lacuna: wrote %s  (%d x %d, %zu views, %zu triangles, %zu markers)\n", args.output.c_str(),
                 result.picture.width, result.picture.height, result.picture.views.size(), result.triangles,
                 result.markers);
+  }
+  return kExitOk;
+}
+
+struct SliceArgs {
+  std::string recipe;
+  std::string output;
+  SliceOptions options;
+};
+
+// `lacuna slice`: a recipe's object as layers (PNG stack, zipped or not, or a CLI file).
+int command_slice(SliceArgs args, const RunOptions& base, const CommonFlags& flags) {
+  args.options.run = base;
+  const SliceReport report = slice_recipe(args.recipe, args.output, args.options);
+  const nlohmann::json j = to_json(report);
+  if (flags.json) std::cout << j.dump(2) << "\n";
+  if (!report.valid) {
+    std::cerr << "lacuna: " << args.recipe << ": layers failed their checks; nothing was written\n";
+    for (size_t i = 0; i < report.problems.size() && i < 20; ++i) std::cerr << "  " << report.problems[i] << "\n";
+    if (report.problems.size() > 20) std::cerr << "  ... and " << report.problems.size() - 20 << " more\n";
+    return kExitCheckFailed;
+  }
+  if (!flags.json && !flags.quiet) {
+    double seconds = 0;
+    for (const auto& s : report.stage_seconds) seconds += s.second;
+    std::printf("lacuna: sliced \"%s\" into %zu layers of %.6g mm (%d x %d pixels of %.6g mm) in %.2f s\n",
+                report.object.c_str(), report.layers.size(), report.layer_mm, report.width, report.height,
+                report.pixel_mm, seconds);
+    std::printf("  wrote %s  (%s, %s, every layer checked)\n", report.output.c_str(), j["format"].get<std::string>().c_str(),
+                format_bytes(report.bytes).c_str());
   }
   return kExitOk;
 }
@@ -367,6 +398,26 @@ int run_app(int argc, char** argv) {
   render->add_option("--max-memory", max_memory_gb, "Memory budget in GB (default: half of the machine's memory)")
       ->check(number_in(0, 1e9, true));
   add_common(render, flags);
+  SliceArgs slice_args;
+  CLI::App* slice = app.add_subcommand(
+      "slice", "A recipe's object as layers for printers, cut from its level set with no mesh: a folder (or .zip) of\n"
+               "greyscale PNG layers with manifest.json, or a CLI file of contours; every layer checked first");
+  slice->add_option("RECIPE", slice_args.recipe, "Recipe (.json)")->required();
+  slice->add_option("-o,--output", slice_args.output, "A folder (PNG layers), FILE.zip (them zipped) or FILE.cli")->required();
+  slice->add_option("--layer-mm", slice_args.options.layer_mm, "Layer height in mm (default: the voxel size)")
+      ->check(number_in(kMinVoxelSizeMm, kMaxVoxelSizeMm));
+  slice->add_option("--pixel-mm", slice_args.options.pixel_mm, "Pixel size in mm (default: the voxel size)")
+      ->check(number_in(kMinVoxelSizeMm, kMaxVoxelSizeMm));
+  slice->add_option("--tolerance-mm", slice_args.options.tolerance_mm,
+                    "CLI: contours simplified within this distance (default: a quarter pixel; 0: not simplified)")
+      ->check(non_negative_number());
+  slice->add_flag("--binary", slice_args.options.binary, "CLI: binary rather than ASCII");
+  slice->add_option("--object", slice_args.options.object, "The recipe's input or operation (default: its first output's)");
+  slice->add_option("--voxel-size", run_options.voxel_size_mm, "Voxel size in mm, overriding the recipe's")
+      ->check(number_in(kMinVoxelSizeMm, kMaxVoxelSizeMm));
+  slice->add_option("--max-memory", max_memory_gb, "Memory budget in GB (default: half of the machine's memory)")
+      ->check(number_in(0, 1e9, true));
+  add_common(slice, flags);
   std::function<int()> cifs_command = add_cifs_commands(app);
   std::function<int()> curve_command = add_curve_commands(app);
   std::function<int()> fill_command = add_fill_commands(app);
@@ -394,6 +445,7 @@ int run_app(int argc, char** argv) {
     if (*check) return command_check(mesh_path, flags, print, run_options.max_memory_bytes);
     if (*fea) return command_fea(fea_args, run_options, flags);
     if (*render) return command_render(render_args, run_options, flags);
+    if (*slice) return command_slice(slice_args, run_options, flags);
     for (const auto& command : {cifs_command, curve_command, fill_command, voronoi_command, bcifs_command}) {
       const int code = command();
       if (code >= 0) return code;

@@ -1,0 +1,372 @@
+// Layers for printers: contours and images of known cross-sections (disks, annuli, islands in holes)
+// against their closed forms, the contour checks against every kind of broken layer, simplification
+// within its tolerance, and `lacuna slice` of spheres: per-layer areas against pi (R^2 - z^2), the PNG
+// stack and both CLI forms read back, identical bytes for any thread count, refusals.
+#include "layers/layers.h"
+
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+#include <zlib.h>
+
+#include <cmath>
+#include <cstring>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "errors.h"
+#include "pipeline/slice_output.h"
+#include "tests/test_support.h"
+
+namespace lacuna {
+namespace {
+
+namespace fs = std::filesystem;
+using test::TempDir;
+using test::write_file;
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Samples of a signed distance function on a grid.
+template <class F>
+std::vector<float> sample(const LayerGrid& g, F f) {
+  std::vector<float> d(g.pixels());
+  for (int j = 0; j < g.height; ++j)
+    for (int i = 0; i < g.width; ++i)
+      d[size_t(j) * g.width + i] = float(f(g.origin_mm.x + i * g.pixel_mm, g.origin_mm.y + j * g.pixel_mm));
+  return d;
+}
+
+LayerGrid square_grid(double half, double pixel) {
+  LayerGrid g;
+  g.pixel_mm = pixel;
+  g.origin_mm = {-half, -half};
+  g.width = g.height = int(std::round(2 * half / pixel)) + 1;
+  return g;
+}
+
+double loop_area(const std::vector<Vec2d>& loop) { return contours_area_mm2(Contours{loop}); }
+
+TEST(Layers, DiskContourAndImageMatchTheClosedForm) {
+  const LayerGrid g = square_grid(6, 0.05);
+  const double r = 4.3;
+  const auto d = sample(g, [&](double x, double y) { return std::hypot(x, y) - r; });
+  const Contours c = contour_layer(d, g);
+  ASSERT_EQ(c.size(), 1u);
+  EXPECT_GT(loop_area(c[0]), 0);  // counter-clockwise
+  // Chords of a circle through points on it: the polygon's area is short by about perimeter * s^2 / (12 r).
+  EXPECT_NEAR(contours_area_mm2(c), kPi * r * r, 2 * kPi * r * 0.05 * 0.05 / r);
+  EXPECT_NEAR(contours_length_mm(c), 2 * kPi * r, 1e-3 * 2 * kPi * r);
+  // Crossings interpolated linearly along a grid edge, where the distance bends by at most s^2 / (8 r),
+  // and kept a hundredth of a pixel off the samples.
+  for (const Vec2d& p : c[0]) EXPECT_NEAR(std::hypot(p.x, p.y), r, 0.05 * 0.05 / (8 * r) + 0.01 * 0.05);
+  EXPECT_TRUE(check_contours(c).valid());
+  // The image: its area within a small fraction of a pixel along the boundary.
+  EXPECT_NEAR(image_area_mm2(coverage_image(d, g), g), kPi * r * r, 0.05 * 2 * kPi * r * 0.05);
+}
+
+TEST(Layers, AnnulusAndIslandNestAndAlternate) {
+  const LayerGrid g = square_grid(8, 0.04);
+  // A disk of radius 7 with a hole of radius 4 holding an island of radius 2.
+  const auto d = sample(g, [](double x, double y) {
+    const double q = std::hypot(x, y);
+    return std::min(std::max(q - 7, 4 - q), q - 2);  // the annulus united with the island
+  });
+  const Contours c = contour_layer(d, g);
+  ASSERT_EQ(c.size(), 3u);
+  std::vector<double> areas;
+  for (const auto& loop : c) areas.push_back(loop_area(loop));
+  std::sort(areas.begin(), areas.end());
+  EXPECT_NEAR(areas[0], -kPi * 16, 0.01);  // the hole, clockwise
+  EXPECT_NEAR(areas[1], kPi * 4, 0.01);    // the island, counter-clockwise
+  EXPECT_NEAR(areas[2], kPi * 49, 0.01);
+  EXPECT_NEAR(contours_area_mm2(c), kPi * (49 - 16 + 4), 0.03);
+  const ContourCheck check = check_contours(c);
+  EXPECT_TRUE(check.valid()) << (check.problems.empty() ? "" : check.problems.front());
+}
+
+TEST(Layers, SaddlesJoinByTheCellsMean) {
+  // Two squares touching corner to corner across one cell: inside corners (0,0) and (1,1) of the cell.
+  LayerGrid g;
+  g.pixel_mm = 1;
+  g.width = g.height = 4;
+  auto grid = [&](std::vector<float> v) { return v; };
+  // Row-major, j = 0 first; the cell between pixels (1,1) and (2,2) is the saddle.
+  std::vector<float> d = grid({1, 1, 1, 1,   //
+                               1, -1, 1, 1,  //
+                               1, 1, -1, 1,  //
+                               1, 1, 1, 1});
+  EXPECT_EQ(contour_layer(d, g).size(), 2u);  // the mean (0) is outside: two loops
+  d[1 * 4 + 1] = -3;
+  d[2 * 4 + 2] = -3;  // the mean is inside now: one loop through the cell
+  const Contours joined = contour_layer(d, g);
+  ASSERT_EQ(joined.size(), 1u);
+  EXPECT_TRUE(check_contours(joined).valid());
+}
+
+TEST(Layers, ChecksFindEveryKindOfBrokenLayer) {
+  const std::vector<Vec2d> square = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  EXPECT_TRUE(check_contours({square}).valid());
+  // Clockwise with nothing around it.
+  const std::vector<Vec2d> backwards(square.rbegin(), square.rend());
+  ContourCheck c = check_contours({backwards});
+  EXPECT_FALSE(c.oriented);
+  // A hole wound like its outer boundary.
+  const std::vector<Vec2d> inner = {{0.25, 0.25}, {0.75, 0.25}, {0.75, 0.75}, {0.25, 0.75}};
+  EXPECT_FALSE(check_contours({square, inner}).oriented);
+  EXPECT_TRUE(check_contours({square, std::vector<Vec2d>(inner.rbegin(), inner.rend())}).valid());
+  // A bow tie crosses itself.
+  c = check_contours({{{0, 0}, {1, 1}, {1, 0}, {0, 1}}});
+  EXPECT_FALSE(c.simple);
+  // Two squares overlapping, and two touching at a corner.
+  EXPECT_FALSE(check_contours({square, {{0.5, 0.5}, {1.5, 0.5}, {1.5, 1.5}, {0.5, 1.5}}}).disjoint);
+  EXPECT_FALSE(check_contours({square, {{1, 1}, {2, 1}, {2, 2}, {1, 2}}}).disjoint);
+  // Too few points, and a point at infinity.
+  EXPECT_FALSE(check_contours({{{0, 0}, {1, 0}}}).closed);
+  EXPECT_FALSE(check_contours({{{0, 0}, {1, 0}, {HUGE_VAL, 1}}}).closed);
+  // A spike folding back on its own edge.
+  EXPECT_FALSE(check_contours({{{0, 0}, {2, 0}, {1, 0}, {1, 1}}}).simple);
+}
+
+TEST(Layers, SimplifiedContoursStayWithinTheTolerance) {
+  const LayerGrid g = square_grid(6, 0.02);
+  const auto d = sample(g, [](double x, double y) { return std::max(std::abs(x), std::abs(y)) - 4.01; });
+  const Contours plain = contour_layer(d, g);
+  const Contours reduced = simplify_contours(plain, 0.005);
+  ASSERT_EQ(reduced.size(), 1u);
+  // A square's boundary needs little more than its corners' neighbourhoods.
+  EXPECT_LT(reduced[0].size(), plain[0].size() / 20);
+  EXPECT_TRUE(check_contours(reduced).valid());
+  // Every removed vertex within the tolerance of the reduced loop.
+  for (const Vec2d& p : plain[0]) {
+    double best = HUGE_VAL;
+    for (size_t i = 0; i < reduced[0].size(); ++i) {
+      const Vec2d a = reduced[0][i], b = reduced[0][(i + 1) % reduced[0].size()];
+      const Vec2d ab = b - a, ap = p - a;
+      const double t = std::clamp((ap.x * ab.x + ap.y * ab.y) / (ab.x * ab.x + ab.y * ab.y), 0.0, 1.0);
+      best = std::min(best, std::hypot(p.x - a.x - t * ab.x, p.y - a.y - t * ab.y));
+    }
+    EXPECT_LE(best, 0.005 + 1e-12);
+  }
+  EXPECT_NEAR(contours_area_mm2(reduced), 8.02 * 8.02, 0.02);
+}
+
+// --- lacuna slice ------------------------------------------------------------------------------
+
+// The polylines of a CLI file per layer, ASCII or binary, read here independently of the writer.
+std::vector<Contours> read_cli(const std::string& bytes, std::vector<double>* tops) {
+  std::vector<Contours> layers;
+  const size_t end = bytes.find("$$HEADEREND");
+  EXPECT_NE(end, std::string::npos);
+  if (bytes.find("$$BINARY") < end) {
+    size_t at = end + std::strlen("$$HEADEREND");
+    auto take = [&](auto v) {
+      std::memcpy(&v, bytes.data() + at, sizeof v);
+      at += sizeof v;
+      return v;
+    };
+    while (at < bytes.size()) {
+      const uint16_t command = take(uint16_t());
+      if (command == 127) {
+        tops->push_back(take(float()));
+        layers.emplace_back();
+      } else {
+        EXPECT_EQ(command, 130);
+        take(int32_t());
+        const int32_t direction = take(int32_t()), n = take(int32_t());
+        std::vector<Vec2d> loop;
+        for (int32_t i = 0; i < n; ++i) {
+          const float x = take(float()), y = take(float());
+          loop.push_back({x, y});
+        }
+        EXPECT_TRUE(loop.front() == loop.back());
+        loop.pop_back();
+        EXPECT_EQ(direction, loop_area(loop) > 0 ? 1 : 0);
+        layers.back().push_back(loop);
+      }
+    }
+    return layers;
+  }
+  std::istringstream in(bytes.substr(end));
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("$$LAYER/", 0) == 0) {
+      tops->push_back(std::stod(line.substr(8)));
+      layers.emplace_back();
+    } else if (line.rfind("$$POLYLINE/", 0) == 0) {
+      std::vector<double> v;
+      std::stringstream fields(line.substr(11));
+      for (std::string f; std::getline(fields, f, ',');) v.push_back(std::stod(f));
+      std::vector<Vec2d> loop;
+      for (size_t i = 0; i < size_t(v[2]); ++i) loop.push_back({v[3 + 2 * i], v[4 + 2 * i]});
+      EXPECT_EQ(v.size(), 3 + 2 * size_t(v[2]));
+      EXPECT_TRUE(loop.front() == loop.back());
+      loop.pop_back();
+      EXPECT_EQ(int(v[1]), loop_area(loop) > 0 ? 1 : 0);
+      layers.back().push_back(loop);
+    }
+  }
+  return layers;
+}
+
+// An 8-bit greyscale PNG's pixel sum (filter 0 rows, as the layer writer makes them).
+uint64_t png_sum(const std::string& png, int* width, int* height) {
+  auto be32 = [&](size_t at) {
+    return uint32_t(uint8_t(png[at])) << 24 | uint32_t(uint8_t(png[at + 1])) << 16 | uint32_t(uint8_t(png[at + 2])) << 8 |
+           uint8_t(png[at + 3]);
+  };
+  *width = int(be32(16));
+  *height = int(be32(20));
+  EXPECT_EQ(png[24], 8);  // bits
+  EXPECT_EQ(png[25], 0);  // greyscale
+  std::string packed;
+  for (size_t at = 8; at < png.size();) {
+    const uint32_t length = be32(at);
+    if (png.compare(at + 4, 4, "IDAT") == 0) packed += png.substr(at + 8, length);
+    at += 12 + length;
+  }
+  std::string raw((size_t(*width) + 1) * size_t(*height), '\0');
+  uLongf size = raw.size();
+  EXPECT_EQ(uncompress(reinterpret_cast<Bytef*>(raw.data()), &size, reinterpret_cast<const Bytef*>(packed.data()),
+                       packed.size()),
+            Z_OK);
+  uint64_t sum = 0;
+  for (int r = 0; r < *height; ++r) {
+    EXPECT_EQ(raw[size_t(r) * (*width + 1)], 0);
+    for (int i = 0; i < *width; ++i) sum += uint8_t(raw[size_t(r) * (*width + 1) + 1 + i]);
+  }
+  return sum;
+}
+
+std::string sphere_recipe(const TempDir& dir, double radius, double voxel) {
+  const fs::path path = dir / "ball.json";
+  write_file(path, R"({"lacuna_recipe": 1, "name": "ball", "voxel_size_mm": )" + std::to_string(voxel) +
+                       R"(, "inputs": {"ball": {"type": "sphere", "center_mm": [1, 2, 3], "radius_mm": )" +
+                       std::to_string(radius) + R"(}}, "outputs": [{"of": "ball", "file": "ball.stl"}]})");
+  return path.string();
+}
+
+TEST(Slice, SphereLayersMatchTheCrossSections) {
+  TempDir dir;
+  const std::string recipe = sphere_recipe(dir, 5, 0.05);
+  SliceOptions options;
+  options.layer_mm = 0.1;
+  const SliceReport r = slice_recipe(recipe, (dir / "ball.cli").string(), options);
+  ASSERT_TRUE(r.valid) << r.problems.front();
+  EXPECT_NEAR(r.z0_mm, 3 - 5, 0.005);
+  EXPECT_EQ(r.layers.size(), 100u);
+  for (const LayerFigures& f : r.layers) {
+    const double z = f.z_mm - 3, rho2 = 25 - z * z;
+    ASSERT_GT(rho2, 0);
+    const double perimeter = 2 * kPi * std::sqrt(rho2);
+    // The level set resolves the sphere within a small fraction of a voxel; near the poles the
+    // section's radius is that error over the slope.
+    const double allowed = perimeter * 0.01 + (std::abs(z) > 4.8 ? 0.2 : 0.0);
+    EXPECT_NEAR(f.contour_area_mm2, kPi * rho2, allowed) << "z " << z;
+    EXPECT_NEAR(f.image_area_mm2, kPi * rho2, allowed) << "z " << z;
+    EXPECT_EQ(f.contours, 1u);
+  }
+  // Read back: as many layers, tops at multiples of the layer height, the areas the report gives.
+  std::vector<double> tops;
+  const std::vector<Contours> back = read_cli(test::read_file(dir / "ball.cli"), &tops);
+  ASSERT_EQ(back.size(), r.layers.size());
+  for (size_t k = 0; k < back.size(); ++k) {
+    EXPECT_NEAR(tops[k], 0.1 * double(k + 1), 1e-5);
+    EXPECT_TRUE(check_contours(back[k]).valid());
+    // Simplified by a quarter pixel: the area moves by less than that along the boundary.
+    EXPECT_NEAR(contours_area_mm2(back[k]), r.layers[k].contour_area_mm2, 0.25 * 0.05 * r.layers[k].contour_length_mm);
+  }
+  // Binary: the same contours in float32.
+  options.binary = true;
+  ASSERT_TRUE(slice_recipe(recipe, (dir / "binary.cli").string(), options).valid);
+  std::vector<double> binary_tops;
+  const std::vector<Contours> binary = read_cli(test::read_file(dir / "binary.cli"), &binary_tops);
+  ASSERT_EQ(binary.size(), back.size());
+  for (size_t k = 0; k < back.size(); ++k) {
+    EXPECT_NEAR(binary_tops[k], tops[k], 1e-6);
+    EXPECT_NEAR(contours_area_mm2(binary[k]), contours_area_mm2(back[k]), 1e-3);
+  }
+}
+
+TEST(Slice, PngStackReadsBackToTheReportedAreas) {
+  TempDir dir;
+  const std::string recipe = sphere_recipe(dir, 3, 0.05);
+  SliceOptions options;
+  options.layer_mm = 0.25;
+  options.pixel_mm = 0.025;
+  const SliceReport r = slice_recipe(recipe, (dir / "stack").string(), options);
+  ASSERT_TRUE(r.valid);
+  const nlohmann::json manifest = nlohmann::json::parse(test::read_file(dir / "stack" / "manifest.json"));
+  EXPECT_EQ(manifest["layers"], r.layers.size());
+  EXPECT_EQ(manifest["layer_mm"], 0.25);
+  EXPECT_EQ(manifest["pixel_mm"], 0.025);
+  EXPECT_EQ(manifest["files"].size(), r.layers.size());
+  // The stack's corner: the lowest pixel's edge and the sphere's bottom.
+  EXPECT_LT(manifest["origin_mm"][0].get<double>(), 1 - 3);
+  EXPECT_NEAR(manifest["origin_mm"][2].get<double>(), 3 - 3, 0.005);
+  size_t files = 0;
+  for (const auto& entry : fs::directory_iterator(dir / "stack")) files += entry.path().filename().string()[0] != '.';
+  EXPECT_EQ(files, r.layers.size() + 1);  // no lock or temporary left
+  for (size_t k = 0; k < r.layers.size(); ++k) {
+    int w = 0, h = 0;
+    const uint64_t sum = png_sum(test::read_file(dir / "stack" / manifest["files"][k].get<std::string>()), &w, &h);
+    EXPECT_EQ(w, r.width);
+    EXPECT_EQ(h, r.height);
+    EXPECT_NEAR(double(sum) / 255 * 0.025 * 0.025, r.layers[k].image_area_mm2, 1e-9);
+    const double z = r.layers[k].z_mm - 3;
+    EXPECT_NEAR(r.layers[k].image_area_mm2, kPi * (9 - z * z), 2 * kPi * 3 * 0.01 + (std::abs(z) > 2.8 ? 0.2 : 0.0));
+  }
+}
+
+TEST(Slice, IdenticalBytesForAnyThreadCount) {
+  TempDir dir;
+  const std::string recipe = sphere_recipe(dir, 2.5, 0.05);
+  std::string bytes[3][2];
+  for (int threads : {1, 2}) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+    SliceOptions options;
+    options.layer_mm = 0.1;
+    const std::string t = std::to_string(threads);
+    ASSERT_TRUE(slice_recipe(recipe, (dir / ("a" + t + ".cli")).string(), options).valid);
+    ASSERT_TRUE(slice_recipe(recipe, (dir / ("z" + t + ".zip")).string(), options).valid);
+    options.binary = true;
+    ASSERT_TRUE(slice_recipe(recipe, (dir / ("b" + t + ".cli")).string(), options).valid);
+    bytes[0][threads - 1] = test::read_file(dir / ("a" + t + ".cli"));
+    bytes[1][threads - 1] = test::read_file(dir / ("z" + t + ".zip"));
+    bytes[2][threads - 1] = test::read_file(dir / ("b" + t + ".cli"));
+  }
+  for (auto& pair : bytes) {
+    EXPECT_FALSE(pair[0].empty());
+    EXPECT_EQ(pair[0], pair[1]);
+  }
+}
+
+TEST(Slice, RefusesClearlyAndLeavesNothing) {
+  TempDir dir;
+  const std::string recipe = sphere_recipe(dir, 2, 0.1);
+  SliceOptions options;
+  EXPECT_THROW(slice_recipe(recipe, (dir / "x.sl1").string(), options), InvalidInput);
+  EXPECT_THROW(slice_recipe(recipe, (dir / "x.stl").string(), options), InvalidInput);
+  options.object = "nothing";
+  EXPECT_THROW(slice_recipe(recipe, (dir / "x.cli").string(), options), InvalidInput);
+  options.object.clear();
+  options.pixel_mm = 1e-4;  // 40 000 x 40 000 pixels per layer
+  try {
+    slice_recipe(recipe, (dir / "x.cli").string(), options);
+    ADD_FAILURE() << "expected a refusal";
+  } catch (const ResourceLimit& e) {
+    EXPECT_NE(std::string(e.what()).find("--pixel-mm"), std::string::npos) << e.what();
+  }
+  // The command line: exit 2 for a bad extension, nothing on disk.
+  const test::Result bad = test::lacuna("slice " + test::quote(recipe) + " -o " + test::quote((dir / "x.sl1").string()),
+                                        dir.path());
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("x.sl1"), std::string::npos) << bad.err;
+  for (const auto& entry : fs::directory_iterator(dir.path())) EXPECT_EQ(entry.path().filename(), "ball.json");
+  const test::Result ok = test::lacuna("slice " + test::quote(recipe) + " -o " + test::quote((dir / "x.cli").string()) +
+                                           " --layer-mm 0.2",
+                                       dir.path());
+  EXPECT_EQ(ok.code, 0) << ok.err;
+  EXPECT_NE(ok.out.find("20 layers of 0.2 mm"), std::string::npos) << ok.out;
+}
+
+}  // namespace
+}  // namespace lacuna
