@@ -158,4 +158,107 @@ std::string cli_file(const LayerStack& stack, const std::vector<Contours>& layer
   return out;
 }
 
+std::string sl1_layer_name(const std::string& job, size_t layer) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%05zu.png", layer);
+  return job + buf;
+}
+
+namespace {
+
+std::string number(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+
+std::string fixed6(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.6f", v);
+  return buf;
+}
+
+}  // namespace
+
+std::string sl1_config_ini(const Sl1Job& job, const Sl1Printer& printer) {
+  const std::pair<const char*, std::string> keys[] = {
+      {"action", "print"},
+      {"expTime", number(printer.exposure_s)},
+      {"expTimeFirst", number(printer.initial_exposure_s)},
+      {"expUserProfile", "0"},
+      // Fixed, so that one recipe gives one archive byte for byte.
+      {"fileCreationTimestamp", "1970-01-01 at 00:00:00 UTC"},
+      {"hollow", "0"},
+      {"jobDir", job.name},
+      {"layerHeight", number(job.layer_mm)},
+      {"materialName", ""},
+      {"numFade", std::to_string(printer.faded_layers)},
+      {"numFast", std::to_string(job.layers - job.slow_layers)},
+      {"numSlow", std::to_string(job.slow_layers)},
+      {"printProfile", ""},
+      {"printTime", fixed6(job.print_s)},
+      {"printerModel", ""},
+      {"printerProfile", ""},
+      {"printerVariant", ""},
+      {"prusaSlicerVersion", "Lacuna-" LACUNA_VERSION},
+      {"usedMaterial", fixed6(job.used_ml)},
+  };
+  std::string out;
+  for (const auto& [key, value] : keys) out += std::string(key) + " = " + value + "\n";
+  return out;
+}
+
+std::string sl1_prusaslicer_ini(const Sl1Job& job, const Sl1Printer& p) {
+  const std::string w = number(p.display_width_mm), h = number(p.display_height_mm);
+  const std::pair<const char*, std::string> keys[] = {
+      {"absolute_correction", "0"}, {"area_fill", number(p.area_fill_percent)},
+      {"bed_shape", "0x0," + w + "x0," + w + "x" + h + ",0x" + h}, {"bottle_cost", "0"}, {"bottle_volume", "1000"},
+      {"bottle_weight", "1"}, {"display_height", h}, {"display_mirror_x", "1"}, {"display_mirror_y", "0"},
+      {"display_orientation", "portrait"}, {"display_pixels_x", std::to_string(p.display_pixels_x)},
+      {"display_pixels_y", std::to_string(p.display_pixels_y)}, {"display_width", w},
+      {"elefant_foot_compensation", "0"}, {"elefant_foot_min_width", "0.2"}, {"exposure_time", number(p.exposure_s)},
+      {"faded_layers", std::to_string(p.faded_layers)}, {"fast_tilt_time", number(p.fast_tilt_s)},
+      {"gamma_correction", "1"}, {"high_viscosity_tilt_time", "10"}, {"hollowing_closing_distance", "2"},
+      {"hollowing_enable", "0"}, {"hollowing_min_thickness", "3"}, {"hollowing_quality", "0.5"},
+      {"initial_exposure_time", number(p.initial_exposure_s)}, {"initial_layer_height", number(job.layer_mm)},
+      {"layer_height", number(job.layer_mm)}, {"material_correction", "1,1,1"}, {"material_correction_x", "1"},
+      {"material_correction_y", "1"}, {"material_correction_z", "1"}, {"material_density", "1"},
+      {"material_print_speed", "fast"}, {"max_exposure_time", "100"}, {"max_initial_exposure_time", "150"},
+      {"max_print_height", "200"}, {"min_exposure_time", "0"}, {"min_initial_exposure_time", "0"},
+      {"output_filename_format", "[input_filename_base].sl1"}, {"pad_around_object", "0"},
+      {"pad_around_object_everywhere", "0"}, {"pad_brim_size", "1.6"}, {"pad_enable", "0"},
+      {"pad_max_merge_distance", "50"}, {"pad_object_connector_penetration", "0.3"},
+      {"pad_object_connector_stride", "10"}, {"pad_object_connector_width", "0.5"}, {"pad_object_gap", "1"},
+      {"pad_wall_height", "0"}, {"pad_wall_slope", "90"}, {"pad_wall_thickness", "2"},
+      {"physical_printer_settings_id", ""}, {"printer_settings_id", ""}, {"printer_technology", "SLA"},
+      {"relative_correction", "1,1"}, {"relative_correction_x", "1"}, {"relative_correction_y", "1"},
+      {"relative_correction_z", "1"}, {"sla_material_settings_id", ""}, {"sla_print_settings_id", ""},
+      {"slice_closing_radius", "0.049"}, {"slicing_mode", "regular"}, {"slow_tilt_time", number(p.slow_tilt_s)},
+      {"support_base_diameter", "4"}, {"support_base_height", "1"}, {"support_base_safety_distance", "1"},
+      {"support_buildplate_only", "0"}, {"support_critical_angle", "45"}, {"support_head_front_diameter", "0.4"},
+      {"support_head_penetration", "0.2"}, {"support_head_width", "1"}, {"support_max_bridge_length", "15"},
+      {"support_max_bridges_on_pillar", "3"}, {"support_max_pillar_link_distance", "10"},
+      {"support_object_elevation", "5"}, {"support_pillar_connection_mode", "dynamic"},
+      {"support_pillar_diameter", "1"}, {"support_pillar_widening_factor", "0"},
+      {"support_points_density_relative", "100"}, {"support_points_minimal_distance", "1"},
+      {"support_small_pillar_diameter_percent", "50%"}, {"supports_enable", "0"},
+  };
+  std::string out;
+  for (const auto& [key, value] : keys) out += std::string(key) + " = " + value + "\n";
+  return out;
+}
+
+double sl1_print_seconds(const std::vector<double>& areas, double layer_mm, const Sl1Printer& p, size_t* slow_layers) {
+  const double display_mm2 = p.display_width_mm * p.display_height_mm;
+  double seconds = 0;
+  *slow_layers = 0;
+  for (size_t k = 0; k < areas.size(); ++k) {
+    const bool slow = areas[k] > p.area_fill_percent / 100 * display_mm2;
+    *slow_layers += slow;
+    seconds += (k < size_t(p.faded_layers) ? p.initial_exposure_s : p.exposure_s) + (slow ? p.slow_tilt_s : p.fast_tilt_s) +
+               5 * layer_mm;
+  }
+  return seconds;
+}
+
 }  // namespace lacuna

@@ -20,7 +20,7 @@ std::vector<float> sample_layer(const Volume& volume, double z_mm, const LayerGr
   tbb::parallel_for(tbb::blocked_range<int>(0, grid.height, 8), [&](const tbb::blocked_range<int>& rows) {
     openvdb::FloatGrid::ConstAccessor accessor = volume.impl().grid->getConstAccessor();
     for (int j = rows.begin(); j < rows.end(); ++j) {
-      const double y = (grid.origin_mm.y + j * grid.pixel_mm) * inv_h;
+      const double y = (grid.origin_mm.y + j * grid.pixel_y_mm()) * inv_h;
       float* row = out.data() + size_t(j) * size_t(grid.width);
       for (int i = 0; i < grid.width; ++i) {
         const openvdb::Vec3d index((grid.origin_mm.x + i * grid.pixel_mm) * inv_h, y, z_mm * inv_h);

@@ -343,7 +343,7 @@ TEST(Slice, RefusesClearlyAndLeavesNothing) {
   TempDir dir;
   const std::string recipe = sphere_recipe(dir, 2, 0.1);
   SliceOptions options;
-  EXPECT_THROW(slice_recipe(recipe, (dir / "x.sl1").string(), options), InvalidInput);
+  EXPECT_THROW(slice_recipe(recipe, (dir / "x.pwmx").string(), options), InvalidInput);
   EXPECT_THROW(slice_recipe(recipe, (dir / "x.stl").string(), options), InvalidInput);
   options.object = "nothing";
   EXPECT_THROW(slice_recipe(recipe, (dir / "x.cli").string(), options), InvalidInput);
@@ -356,16 +356,67 @@ TEST(Slice, RefusesClearlyAndLeavesNothing) {
     EXPECT_NE(std::string(e.what()).find("--pixel-mm"), std::string::npos) << e.what();
   }
   // The command line: exit 2 for a bad extension, nothing on disk.
-  const test::Result bad = test::lacuna("slice " + test::quote(recipe) + " -o " + test::quote((dir / "x.sl1").string()),
+  const test::Result bad = test::lacuna("slice " + test::quote(recipe) + " -o " + test::quote((dir / "x.pwmx").string()),
                                         dir.path());
   EXPECT_EQ(bad.code, 2);
-  EXPECT_NE(bad.err.find("x.sl1"), std::string::npos) << bad.err;
+  EXPECT_NE(bad.err.find("x.pwmx"), std::string::npos) << bad.err;
   for (const auto& entry : fs::directory_iterator(dir.path())) EXPECT_EQ(entry.path().filename(), "ball.json");
   const test::Result ok = test::lacuna("slice " + test::quote(recipe) + " -o " + test::quote((dir / "x.cli").string()) +
                                            " --layer-mm 0.2",
                                        dir.path());
   EXPECT_EQ(ok.code, 0) << ok.err;
   EXPECT_NE(ok.out.find("20 layers of 0.2 mm"), std::string::npos) << ok.out;
+}
+
+TEST(Slice, RecipeOutputsAreTheSameLayersWithoutAMesh) {
+  TempDir dir;
+  write_file(dir / "r.json", R"({"lacuna_recipe": 1, "name": "r", "voxel_size_mm": 0.1,
+    "inputs": {"ball": {"type": "sphere", "center_mm": [0, 0, 0], "radius_mm": 3}},
+    "operations": [{"name": "hollow", "op": "shell", "of": "ball", "thickness_mm": 1}],
+    "outputs": [{"of": "hollow", "file": "hollow.cli", "layers": {"layer_mm": 0.2, "binary": true}},
+                {"of": "hollow", "file": "hollow.zip", "layers": {"layer_mm": 0.2, "pixel_mm": 0.05}}]})");
+  RunOptions run_options;
+  run_options.output_dir = (dir / "out").string();
+  const RunReport report = run((dir / "r.json").string(), run_options);
+  ASSERT_TRUE(report.valid);
+  ASSERT_EQ(report.outputs.size(), 2u);
+  ASSERT_TRUE(report.outputs[0].layers);
+  EXPECT_EQ(report.outputs[0].layers->layers, 30u);
+  EXPECT_FALSE(report.outputs[0].check);  // no mesh was made
+  // The same bytes as `lacuna slice` of the object with the same settings.
+  SliceOptions options;
+  options.object = "hollow";
+  options.layer_mm = 0.2;
+  options.binary = true;
+  ASSERT_TRUE(slice_recipe((dir / "r.json").string(), (dir / "alone.cli").string(), options).valid);
+  EXPECT_EQ(test::read_file(dir / "out" / "hollow.cli"), test::read_file(dir / "alone.cli"));
+  options.binary = false;
+  options.pixel_mm = 0.05;
+  ASSERT_TRUE(slice_recipe((dir / "r.json").string(), (dir / "alone.zip").string(), options).valid);
+  EXPECT_EQ(test::read_file(dir / "out" / "hollow.zip"), test::read_file(dir / "alone.zip"));
+  const nlohmann::json j = nlohmann::json::parse(test::read_file(dir / "out" / "report.json"));
+  EXPECT_EQ(j["outputs"][1]["layers"]["count"], 30);
+  EXPECT_EQ(j["outputs"][1]["layers"]["pixel_mm"], 0.05);
+  EXPECT_TRUE(j["outputs"][1]["checks"]["valid"].get<bool>());
+  EXPECT_FALSE(j["outputs"][1].contains("triangles"));
+
+  // Settings that belong to meshes, or to another format, are refused with the key named.
+  const std::pair<const char*, const char*> bad[] = {
+      {R"({"of": "ball", "file": "b.cli", "simplify_mm": 0.01})", "simplify_mm"},
+      {R"({"of": "ball", "file": "b.zip", "layers": {"binary": true}})", "binary"},
+      {R"({"of": "ball", "file": "b.stl", "layers": {"layer_mm": 0.1}})", "layers"},
+      {R"({"of": "ball", "file": "b.cli", "layers": {"layer_mm": -1}})", "layer_mm"},
+      {R"({"of": "ball", "file": "b.cli", "layers": {"thickness": 1}})", "thickness"}};
+  for (const auto& [output, key] : bad) {
+    write_file(dir / "bad.json", std::string(R"({"lacuna_recipe": 1, "voxel_size_mm": 0.1,
+      "inputs": {"ball": {"type": "sphere", "radius_mm": 3}}, "outputs": [)") + output + "]}");
+    try {
+      load_recipe((dir / "bad.json").string());
+      ADD_FAILURE() << output;
+    } catch (const InvalidInput& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace

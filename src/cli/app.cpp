@@ -64,7 +64,12 @@ int command_run(const std::string& recipe, const RunOptions& options, const Comm
     std::printf("lacuna: ran %s in %.2f s, peak memory %s\n", recipe.c_str(), r["total_seconds"].get<double>(),
                 format_bytes(r["peak_memory_bytes"].get<uint64_t>()).c_str());
     for (const auto& out : r["outputs"]) {
-      if (out.contains("tets"))
+      if (out.contains("layers"))
+        std::printf("  wrote %s  (%llu layers of %.6g mm, %d x %d pixels of %.6g mm, every layer checked)\n",
+                    out["file"].get<std::string>().c_str(), (unsigned long long)out["layers"]["count"].get<uint64_t>(),
+                    out["layers"]["layer_mm"].get<double>(), out["layers"]["width"].get<int>(),
+                    out["layers"]["height"].get<int>(), out["layers"]["pixel_mm"].get<double>());
+      else if (out.contains("tets"))
         std::printf("  wrote %s  (%llu nodes, %llu tetrahedra, %.6g mm3, dihedral angles %.3g-%.3g deg)\n",
                     out["file"].get<std::string>().c_str(), (unsigned long long)out["nodes"].get<uint64_t>(),
                     (unsigned long long)out["tets"].get<uint64_t>(), out["volume_mm3"].get<double>(),
@@ -403,7 +408,9 @@ int run_app(int argc, char** argv) {
       "slice", "A recipe's object as layers for printers, cut from its level set with no mesh: a folder (or .zip) of\n"
                "greyscale PNG layers with manifest.json, or a CLI file of contours; every layer checked first");
   slice->add_option("RECIPE", slice_args.recipe, "Recipe (.json)")->required();
-  slice->add_option("-o,--output", slice_args.output, "A folder (PNG layers), FILE.zip (them zipped) or FILE.cli")->required();
+  slice->add_option("-o,--output", slice_args.output,
+                    "A folder (PNG layers), FILE.zip (them zipped), FILE.sl1 (resin printers, as PrusaSlicer writes it) or FILE.cli")
+      ->required();
   slice->add_option("--layer-mm", slice_args.options.layer_mm, "Layer height in mm (default: the voxel size)")
       ->check(number_in(kMinVoxelSizeMm, kMaxVoxelSizeMm));
   slice->add_option("--pixel-mm", slice_args.options.pixel_mm, "Pixel size in mm (default: the voxel size)")

@@ -37,6 +37,7 @@ bool segments_meet(const Vec2d& a, const Vec2d& b, const Vec2d& c, const Vec2d& 
 std::vector<uint8_t> coverage_image(const std::vector<float>& distance, const LayerGrid& grid) {
   const int w = grid.width, h = grid.height;
   std::vector<uint8_t> image(distance.size());
+  const double px = grid.pixel_mm, py = grid.pixel_y_mm();
   auto at = [&](int i, int j) { return double(distance[size_t(j) * size_t(w) + size_t(i)]); };
   for (int j = 0; j < h; ++j) {
     for (int i = 0; i < w; ++i) {
@@ -44,11 +45,13 @@ std::vector<uint8_t> coverage_image(const std::vector<float>& distance, const La
       // The distance within the plane: the 3D distance over the gradient's horizontal part (central
       // differences), so a surface nearly parallel to the layer covers no more than it cuts.
       const double gx = (at(std::min(i + 1, w - 1), j) - at(std::max(i - 1, 0), j)) /
-                        (double(std::min(i + 1, w - 1) - std::max(i - 1, 0)) * grid.pixel_mm);
+                        (double(std::min(i + 1, w - 1) - std::max(i - 1, 0)) * px);
       const double gy = (at(i, std::min(j + 1, h - 1)) - at(i, std::max(j - 1, 0))) /
-                        (double(std::min(j + 1, h - 1) - std::max(j - 1, 0)) * grid.pixel_mm);
+                        (double(std::min(j + 1, h - 1) - std::max(j - 1, 0)) * py);
       const double g = std::max(std::hypot(gx, gy), 1e-3);
-      image[size_t(j) * size_t(w) + size_t(i)] = uint8_t(std::lround(255 * std::clamp(0.5 - d / (g * grid.pixel_mm), 0.0, 1.0)));
+      // The pixel's width across the boundary (its normal along the gradient).
+      const double across = g > 1e-3 ? (std::abs(gx) * px + std::abs(gy) * py) / g : px;
+      image[size_t(j) * size_t(w) + size_t(i)] = uint8_t(std::lround(255 * std::clamp(0.5 - d / (g * across), 0.0, 1.0)));
     }
   }
   return image;
@@ -57,7 +60,7 @@ std::vector<uint8_t> coverage_image(const std::vector<float>& distance, const La
 double image_area_mm2(const std::vector<uint8_t>& image, const LayerGrid& grid) {
   uint64_t sum = 0;
   for (uint8_t v : image) sum += v;
-  return double(sum) / 255 * grid.pixel_mm * grid.pixel_mm;
+  return double(sum) / 255 * grid.pixel_mm * grid.pixel_y_mm();
 }
 
 Contours contour_layer(const std::vector<float>& f, const LayerGrid& grid) {
@@ -76,7 +79,7 @@ Contours contour_layer(const std::vector<float>& f, const LayerGrid& grid) {
     // apart when written with a file's resolution.
     const double t = std::clamp(f0 / (f0 - f1), 0.01, 0.99);
     return Vec2d{grid.origin_mm.x + (i + (i1 - i) * t) * grid.pixel_mm,
-                 grid.origin_mm.y + (j + (j1 - j) * t) * grid.pixel_mm};
+                 grid.origin_mm.y + (j + (j1 - j) * t) * grid.pixel_y_mm()};
   };
   // next[a] = b: the segment leaving crossing a ends at crossing b (the solid on its left).
   std::vector<int64_t> next(size_t(2) * grid.pixels(), -1);

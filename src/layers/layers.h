@@ -12,12 +12,14 @@
 
 namespace lacuna {
 
-// A layer's pixel grid: pixel (i, j) has its centre at origin + (i, j) * pixel_mm.
+// A layer's pixel grid: pixel (i, j) has its centre at origin + (i * pixel_mm, j * pixel_y_mm()).
 struct LayerGrid {
   Vec2d origin_mm;
   double pixel_mm = 0.05;
+  double pixel_height_mm = 0;  // along y, for displays whose pixels are not square; 0: pixel_mm
   int width = 0, height = 0;
   size_t pixels() const { return size_t(width) * size_t(height); }
+  double pixel_y_mm() const { return pixel_height_mm > 0 ? pixel_height_mm : pixel_mm; }
 };
 
 // Closed polylines (mm), the first point not repeated: outer boundaries counter-clockwise, holes

@@ -117,7 +117,8 @@ Estimate estimate(const Recipe& recipe, const Plan& plan, const BuiltInputs& inp
     objects[name] = o;
   }
   for (const RecipeOutput& out : recipe.outputs)
-    for (const std::string& name : members(out)) mesh_of(objects[name].voxels, simplify_deviation_mm(recipe, out));
+    if (!out.layers)  // layers are cut from the level set: no mesh
+      for (const std::string& name : members(out)) mesh_of(objects[name].voxels, simplify_deviation_mm(recipe, out));
   return total;
 }
 

@@ -49,6 +49,7 @@ void annotate(nlohmann::json& entry, const OutputReport& out) {
 
 bool OutputReport::valid() const {
   if (printability && !printability->problems.empty()) return false;
+  if (layers) return layers->problems.empty();
   if (tetrahedra) return tetrahedra->valid();
   return check && check->valid() && objects == group;
 }
@@ -95,6 +96,26 @@ nlohmann::json to_json(const InputReport& report) {
 
 nlohmann::json to_json(const OutputReport& out) {
   nlohmann::json entry;
+  if (out.layers) {
+    const LayerOutputReport& l = *out.layers;
+    entry = {{"file", out.file},
+             {"format", out.format},
+             {"object", out.object},
+             {"layers", {{"count", l.layers},
+                         {"layer_mm", l.layer_mm},
+                         {"pixel_mm", l.pixel_mm},
+                         {"tolerance_mm", l.tolerance_mm},
+                         {"z0_mm", l.z0_mm},
+                         {"width", l.width},
+                         {"height", l.height},
+                         {"contours", l.contours},
+                         {"max_area_difference_mm2", l.max_area_difference_mm2},
+                         {"bytes", l.bytes}}},
+             {"checks", {{"valid", l.problems.empty()}, {"problems", l.problems}}},
+             {"voxels", out.voxels}};
+    annotate(entry, out);
+    return entry;
+  }
   if (out.tetrahedra) {
     entry = fea_report_json(*out.tetrahedra);
     entry["file"] = out.file;

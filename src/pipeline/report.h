@@ -98,10 +98,22 @@ struct PrintabilityFindings {
   std::vector<std::string> problems;  // what fails the output (none with "report")
 };
 
+// A layer output (.cli, a zipped PNG stack): what cutting and checking its layers found.
+struct LayerOutputReport {
+  size_t layers = 0;
+  double layer_mm = 0, pixel_mm = 0, tolerance_mm = 0;
+  double z0_mm = 0;                   // the bottom of layer 0
+  int width = 0, height = 0;          // pixels per layer
+  double max_area_difference_mm2 = 0; // between a layer's image and its contours
+  size_t contours = 0;                // over every layer
+  uint64_t bytes = 0;
+  std::vector<std::string> problems;  // what failed (nothing written then)
+};
+
 // One written file and what its checks found.
 struct OutputReport {
   std::string file;    // final path
-  std::string format;  // "stl", "3mf", "msh", "inp", "vtu", "mesh"
+  std::string format;  // "stl", "3mf", "drc", "msh", "inp", "vtu", "mesh", "cli", "png_layers"
   std::string object;  // the input or operation (of a group: the first)
   std::string part_name;              // surface outputs: the object's name in the file
   std::vector<std::string> group;     // a 3MF of several objects: the objects asked for ...
@@ -115,6 +127,7 @@ struct OutputReport {
   std::optional<DracoFigures> draco;     // .drc outputs: quantization and size
   std::string picture;                   // the PNG rendered of it ("render"), final path; empty: none
   std::optional<TetCheck> tetrahedra;    // tetrahedral outputs
+  std::optional<LayerOutputReport> layers;  // layer outputs (no mesh)
   std::optional<PrintabilityFindings> printability;
   std::optional<double> hull_volume_mm3;  // infill objects: the hull's volume, for the relative density
 

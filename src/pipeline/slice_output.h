@@ -8,14 +8,18 @@
 #include <string>
 #include <vector>
 
+#include "export/layers_io.h"
+#include "layers/layers.h"
 #include "pipeline/pipeline.h"
+#include "solids/volume.h"
 
 namespace lacuna {
 
-enum class LayerFormat { kPng, kPngZip, kCli, kCliBinary };
+enum class LayerFormat { kPng, kPngZip, kCli, kCliBinary, kSl1 };
 
-// The format a path asks for: .cli (ASCII unless `binary`), .zip (a zipped PNG stack), anything
-// else a folder of PNGs. Throws InvalidInput for .sl1 and other archive kinds it cannot write.
+// The format a path asks for: .cli (ASCII unless `binary`), .zip (a zipped PNG stack), .sl1 (an SL1
+// archive for resin printers, as PrusaSlicer writes them), anything else a folder of PNGs. Throws
+// InvalidInput for other archive kinds it cannot write.
 LayerFormat layer_format_from_path(const std::string& path, bool binary);
 
 struct SliceOptions {
@@ -49,6 +53,35 @@ struct SliceReport {
   bool valid = false;  // every layer passed; otherwise nothing was written
   std::vector<std::string> problems;
 };
+
+// How to cut one solid into layers.
+struct LayerSettings {
+  LayerFormat format = LayerFormat::kPng;
+  std::string name;            // the object's, in the files
+  double layer_mm = 0;         // 0: the voxel size
+  double pixel_mm = 0;         // 0: the voxel size
+  double tolerance_mm = -1;    // CLI simplification; < 0: a quarter pixel
+  Sl1Printer printer;          // SL1: the display (its pixels replace pixel_mm) and exposures
+};
+
+// A solid cut into layers, checked, not written: the report's figures and problems, and the layers.
+struct SlicedLayers {
+  SliceReport report;              // output, object and bytes unset
+  LayerStack stack;
+  std::vector<std::string> pngs;   // PNG formats and SL1: one image per layer
+  Sl1Job job;                      // SL1: what config.ini reports
+  Sl1Printer printer;
+  std::vector<Contours> contours;  // CLI formats: per layer, as they will be written
+};
+
+// Cuts `volume` into layers and checks them (the report is not valid when a layer failed). `what`
+// names the solid in messages. Throws InvalidInput for bad sizes or an empty solid, ResourceLimit past
+// a million layers, 2^28 pixels per layer or the budget (0: half the memory available).
+SlicedLayers slice_volume(const Volume& volume, const LayerSettings& settings, const std::string& what,
+                          uint64_t max_memory_bytes = 0);
+
+// The one file of a zipped PNG stack or a CLI file; `where` names it in messages.
+std::string layers_file(const SlicedLayers& sliced, const std::string& where);
 
 // Slices the recipe's object into `output`. Throws as run() does (InvalidInput, IoError,
 // ResourceLimit, Cancelled) and InvalidInput for bad sizes or an empty object; when a layer fails its

@@ -22,6 +22,7 @@
 #include "pipeline/input_figures.h"
 #include "pipeline/mesh_object.h"
 #include "pipeline/render_output.h"
+#include "pipeline/slice_output.h"
 #include "solids/check.h"
 #include "solids/components.h"
 #include "solids/printability.h"
@@ -124,7 +125,7 @@ void add_page_mesh(ReportPage& page, const Recipe& recipe, const std::string& ob
   PageMesh m;
   m.object = object;
   for (const RecipeOutput& out : recipe.outputs)
-    if (out.object == object || std::find(out.group.begin(), out.group.end(), object) != out.group.end())
+    if (!out.layers && (out.object == object || std::find(out.group.begin(), out.group.end(), object) != out.group.end()))
       m.outputs.push_back(out.file);
   if (mesh.triangles.size() > kPageMaxTriangles) {
     page.skipped.push_back({object, std::to_string(mesh.triangles.size()) + " triangles, more than a page shows (" +
@@ -186,12 +187,16 @@ RunReport write_outputs(const Recipe& recipe, const Plan& plan, Evaluation&& eva
       throw_if_cancelled(sink);
       timer.start("mesh");
       Volume volume = evaluation.take(object);
+      auto exports = [&](const RecipeOutput& out) {
+        return out.object == object || std::find(out.group.begin(), out.group.end(), object) != out.group.end();
+      };
+      // Layer outputs are cut from the level set; a mesh is made only for the others.
       double smallest_deviation = HUGE_VAL;
       for (const RecipeOutput& out : recipe.outputs)
-        if (out.object == object || std::find(out.group.begin(), out.group.end(), object) != out.group.end())
-          smallest_deviation = std::min(smallest_deviation, simplify_deviation_mm(recipe, out));
-      detail::require_mesh_memory(volume, budget, recipe.file + ": meshing \"" + object + "\"", vopt,
-                                  std::isfinite(smallest_deviation) ? smallest_deviation : 0);
+        if (exports(out) && !out.layers) smallest_deviation = std::min(smallest_deviation, simplify_deviation_mm(recipe, out));
+      const bool meshed = std::isfinite(smallest_deviation);
+      if (meshed)
+        detail::require_mesh_memory(volume, budget, recipe.file + ": meshing \"" + object + "\"", vopt, smallest_deviation);
       std::optional<PrintabilityFindings> printability;
       if (recipe.printability.enabled) {
         timer.start("printability");
@@ -199,22 +204,67 @@ RunReport write_outputs(const Recipe& recipe, const Plan& plan, Evaluation&& eva
         timer.start("mesh");
       }
       const uint64_t voxels = volume.active_voxel_count();
+      for (const RecipeOutput& out : recipe.outputs) {
+        if (!exports(out) || !out.layers) continue;
+        timer.start("slice");
+        const std::string final_path = (out_dir / out.file).string();
+        LayerSettings settings;
+        settings.format = out.format == "cli"   ? (out.layers->binary ? LayerFormat::kCliBinary : LayerFormat::kCli)
+                          : out.format == "sl1" ? LayerFormat::kSl1
+                                                : LayerFormat::kPngZip;
+        settings.name = out.part_name;
+        settings.layer_mm = out.layers->layer_mm;
+        settings.pixel_mm = out.layers->pixel_mm;
+        settings.tolerance_mm = out.layers->tolerance_mm;
+        const SlicedLayers sliced = slice_volume(volume, settings, recipe.file + ": " + out.json_path + " (\"" + object + "\")", budget);
+        const SliceReport& s = sliced.report;
+        OutputReport entry;
+        entry.file = final_path;
+        entry.format = out.format;
+        entry.object = out.object;
+        entry.part_name = out.part_name;
+        entry.voxels = voxels;
+        entry.printability = printability;
+        LayerOutputReport layers;
+        layers.layers = s.layers.size();
+        layers.layer_mm = s.layer_mm;
+        layers.pixel_mm = s.pixel_mm;
+        layers.tolerance_mm = s.tolerance_mm;
+        layers.z0_mm = s.z0_mm;
+        layers.width = s.width;
+        layers.height = s.height;
+        for (const LayerFigures& f : s.layers) {
+          layers.contours += f.contours;
+          layers.max_area_difference_mm2 =
+              std::max(layers.max_area_difference_mm2, std::abs(f.image_area_mm2 - f.contour_area_mm2));
+        }
+        layers.problems = s.problems;
+        if (s.valid) {
+          timer.start("write");
+          const std::string bytes = layers_file(sliced, final_path);
+          write_whole_file(transaction.stage(final_path), bytes);
+          layers.bytes = bytes.size();
+        }
+        entry.layers = std::move(layers);
+        report.outputs.push_back(std::move(entry));
+        timer.start("mesh");
+      }
       // One surface per deviation the object's outputs ask for (usually one): the compact mesh is
       // extracted and simplified block by block, so the full marching-tetrahedra mesh never exists.
       std::map<double, ObjectMesh> surfaces;
       for (const RecipeOutput& out : recipe.outputs) {
-        const bool exports = out.object == object ||
-                             std::find(out.group.begin(), out.group.end(), object) != out.group.end();
         const double deviation = simplify_deviation_mm(recipe, out);
-        if (!exports || surfaces.count(deviation)) continue;
+        if (!exports(out) || out.layers || surfaces.count(deviation)) continue;
         const ObjectMesh& surface = surfaces[deviation] = extract_object_surface(volume, deviation);
         if (surface.mesh.triangles.empty())
           throw InvalidInput(recipe.file + ": \"" + object + "\" is empty: nothing is left to export");
       }
       volume = Volume();
-      if (options.write_report) {
+      if (options.write_report && meshed) {
         timer.start("report");
         add_page_mesh(page, recipe, object, surfaces.begin()->second.mesh, printability, vopt.voxel_size_mm);
+      } else if (options.write_report) {
+        page.skipped.push_back({object, "written as layers only: no mesh was made"});
       }
       auto surface_for = [&](const RecipeOutput& out) -> const ObjectMesh& {
         return surfaces.at(simplify_deviation_mm(recipe, out));
@@ -279,7 +329,7 @@ RunReport write_outputs(const Recipe& recipe, const Plan& plan, Evaluation&& eva
           written.push_back({&out, temp, final_path});
           continue;
         }
-        if (out.object != object) continue;
+        if (out.object != object || out.layers) continue;
         std::string final_path = (out_dir / out.file).string();
         const TriMesh& surface = surface_for(out).mesh;
         if (out.format == "drc") {

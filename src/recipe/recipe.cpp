@@ -294,7 +294,7 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
   std::set<std::string> files;
   for (size_t i = 0; i < outs.size(); ++i) {
     JsonObject o(outs[i], path, "outputs[" + std::to_string(i) + "]");
-    o.allow_only({"of", "file", "name", "simplify_mm", "decimate_mm", "fea", "quantize_mm", "render"});
+    o.allow_only({"of", "file", "name", "simplify_mm", "decimate_mm", "fea", "quantize_mm", "render", "layers"});
     RecipeOutput out;
     out.json_path = o.path();
     auto known = [&](const std::string& name) {
@@ -324,11 +324,12 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
                      "control characters or leading '.', at most 200 characters");
     std::string ext = lower(fs::path(out.file).extension().string());
     const std::map<std::string, std::string> formats = {{".stl", "stl"}, {".3mf", "3mf"}, {".drc", "drc"}, {".msh", "msh"},
-                                                        {".inp", "inp"}, {".vtu", "vtu"}, {".mesh", "mesh"}};
+                                                        {".inp", "inp"}, {".vtu", "vtu"}, {".mesh", "mesh"},
+                                                        {".cli", "cli"}, {".zip", "png_layers"}, {".sl1", "sl1"}};
     auto format = formats.find(ext);
     if (format == formats.end())
-      o.fail("file", "expected a file name ending in .stl, .3mf or .drc (or .msh, .inp, .vtu, .mesh for tetrahedra), got \"" +
-                         out.file + "\"");
+      o.fail("file", "expected a file name ending in .stl, .3mf or .drc (or .msh, .inp, .vtu, .mesh for tetrahedra, .cli, "
+                     ".sl1 or .zip for layers), got \"" + out.file + "\"");
     out.format = format->second;
     if (!out.group.empty() && out.format != "3mf")
       o.fail("of", "a list of objects needs a .3mf file (one object each), got \"" + out.file + "\"");
@@ -337,9 +338,37 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
       o.fail("file", "\"" + out.file + "\" is written twice or clashes with report.json");
     if (o.has("simplify_mm") && o.has("decimate_mm"))
       o.fail("decimate_mm", "give \"simplify_mm\" only (\"decimate_mm\" is its older name)");
+    const bool layered = out.format == "cli" || out.format == "png_layers" || out.format == "sl1";
+    if (layered) {
+      if (!out.group.empty()) o.fail("of", "layers are cut from one object: give one name");
+      for (const char* key : {"simplify_mm", "decimate_mm", "quantize_mm", "fea", "render"})
+        if (o.has(key)) o.fail(key, "layers (.cli, .sl1, .zip) are cut from the level set: no mesh, so no \"" + std::string(key) + "\"");
+      RecipeOutput::Layers layers;
+      if (o.has("layers")) {
+        JsonObject l = o.object("layers");
+        l.allow_only({"layer_mm", "pixel_mm", "tolerance_mm", "binary"});
+        layers.layer_mm = l.positive_length_or("layer_mm", 0.0);
+        layers.pixel_mm = l.positive_length_or("pixel_mm", 0.0);
+        if (l.has("tolerance_mm")) {
+          layers.tolerance_mm = l.number_or("tolerance_mm", 0.0);
+          if (!(layers.tolerance_mm >= 0) || !std::isfinite(layers.tolerance_mm))
+            l.fail("tolerance_mm", "expected a length >= 0 (0: contours not simplified)");
+        }
+        layers.binary = l.boolean_or("binary", false);
+        if (out.format == "sl1" && l.has("pixel_mm")) l.fail("pixel_mm", "an SL1 archive has the printer's pixels");
+        if (layers.binary && out.format != "cli") l.fail("binary", "only a .cli file is binary or ASCII");
+        for (const auto& [key, v] : {std::pair{"layer_mm", layers.layer_mm}, std::pair{"pixel_mm", layers.pixel_mm}})
+          if (v != 0 && (v < kMinVoxelSizeMm || v > kMaxVoxelSizeMm))
+            l.fail(key, "expected a length between " + std::to_string(kMinVoxelSizeMm) + " and " +
+                            std::to_string(kMaxVoxelSizeMm) + " mm");
+      }
+      out.layers = layers;
+    } else if (o.has("layers")) {
+      o.fail("layers", "layer settings need a .cli, .sl1 or .zip file");
+    }
     if (o.has("simplify_mm")) out.simplify_mm = deviation(o, "simplify_mm");
     if (o.has("decimate_mm")) out.simplify_mm = deviation(o, "decimate_mm");
-    const bool tetrahedral = out.format != "stl" && out.format != "3mf" && out.format != "drc";
+    const bool tetrahedral = out.format == "msh" || out.format == "inp" || out.format == "vtu" || out.format == "mesh";
     if (o.has("quantize_mm")) {
       if (out.format != "drc") o.fail("quantize_mm", "only a .drc output is quantized");
       out.quantize_mm = o.positive_length_or("quantize_mm", 0.0);

@@ -91,7 +91,7 @@ struct RecipeOutput {
   // operation; empty for a single object.
   std::vector<std::string> group;
   std::string file;       // a plain file name inside the output folder
-  std::string format;     // "stl", "3mf", "drc", or a tetrahedral format "msh", "inp", "vtu", "mesh"
+  std::string format;     // "stl", "3mf", "drc", a tetrahedral format "msh", "inp", "vtu", "mesh", or layers "cli", "sl1", "png_layers"
   std::string part_name;  // object name inside the file (3MF)
   // Deviation of this output's compact mesh (mm; 0: the plain marching-tetrahedra surface);
   // unset: the recipe's. `decimate_mm` is its older name.
@@ -106,6 +106,14 @@ struct RecipeOutput {
     std::optional<double> section;          // cut at this fraction of the height (0 to 1, along z)
   };
   std::optional<Render> render;
+  // Layers cut from the level set (format "cli", "sl1" or "png_layers", a zipped PNG stack): no mesh is made.
+  struct Layers {
+    double layer_mm = 0;       // 0: the voxel size
+    double pixel_mm = 0;       // 0: the voxel size
+    double tolerance_mm = -1;  // CLI contours simplified this far; < 0: a quarter pixel
+    bool binary = false;       // CLI: binary rather than ASCII
+  };
+  std::optional<Layers> layers;
   FeaSettings fea;        // for tetrahedral formats
   std::string json_path;
 };
