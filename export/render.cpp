@@ -11,6 +11,7 @@
 #include <limits>
 
 #include "bcifs/realize.h"
+#include "util/bitmap_font.h"
 #include "export/output_files.h"
 #include "errors.h"
 
@@ -21,42 +22,9 @@ using Rgb = std::array<uint8_t, 3>;
 
 constexpr Rgb kBackground{250, 250, 250}, kInk{30, 30, 30};
 constexpr int kFontScale = 2;                 // 5 x 7 glyphs drawn at 10 x 14 pixels
-constexpr int kGlyphW = 5, kGlyphH = 7;
+constexpr int kGlyphW = kGlyphWidth, kGlyphH = kGlyphHeight;
 constexpr int kTextH = kGlyphH * kFontScale;  // 14
 constexpr int kMargin = 8;
-
-// A 5 x 7 bitmap font: each glyph 7 rows of 5 bits, the leftmost pixel the highest bit. Lower-case
-// letters are drawn as capitals except 'm' (so that "mm" stays millimetres); characters without a
-// glyph as a blank.
-struct Glyph {
-  char c;
-  uint8_t rows[7];
-};
-constexpr Glyph kFont[] = {
-    {'0', {14, 17, 19, 21, 25, 17, 14}}, {'1', {4, 12, 4, 4, 4, 4, 14}},     {'2', {14, 17, 1, 2, 4, 8, 31}},
-    {'3', {31, 2, 4, 2, 1, 17, 14}},     {'4', {2, 6, 10, 18, 31, 2, 2}},    {'5', {31, 16, 30, 1, 1, 17, 14}},
-    {'6', {6, 8, 16, 30, 17, 17, 14}},   {'7', {31, 1, 2, 4, 8, 8, 8}},      {'8', {14, 17, 17, 14, 17, 17, 14}},
-    {'9', {14, 17, 17, 15, 1, 2, 12}},   {'A', {14, 17, 17, 31, 17, 17, 17}}, {'B', {30, 17, 17, 30, 17, 17, 30}},
-    {'C', {14, 17, 16, 16, 16, 17, 14}}, {'D', {28, 18, 17, 17, 17, 18, 28}}, {'E', {31, 16, 16, 30, 16, 16, 31}},
-    {'F', {31, 16, 16, 30, 16, 16, 16}}, {'G', {14, 17, 16, 23, 17, 17, 15}}, {'H', {17, 17, 17, 31, 17, 17, 17}},
-    {'I', {14, 4, 4, 4, 4, 4, 14}},      {'J', {7, 2, 2, 2, 2, 18, 12}},     {'K', {17, 18, 20, 24, 20, 18, 17}},
-    {'L', {16, 16, 16, 16, 16, 16, 31}}, {'M', {17, 27, 21, 21, 17, 17, 17}}, {'N', {17, 17, 25, 21, 19, 17, 17}},
-    {'O', {14, 17, 17, 17, 17, 17, 14}}, {'P', {30, 17, 17, 30, 16, 16, 16}}, {'Q', {14, 17, 17, 17, 21, 18, 13}},
-    {'R', {30, 17, 17, 30, 20, 18, 17}}, {'S', {15, 16, 16, 14, 1, 1, 30}},  {'T', {31, 4, 4, 4, 4, 4, 4}},
-    {'U', {17, 17, 17, 17, 17, 17, 14}}, {'V', {17, 17, 17, 17, 17, 10, 4}}, {'W', {17, 17, 17, 21, 21, 21, 10}},
-    {'X', {17, 17, 10, 4, 10, 17, 17}},  {'Y', {17, 17, 17, 10, 4, 4, 4}},   {'Z', {31, 1, 2, 4, 8, 16, 31}},
-    {'.', {0, 0, 0, 0, 0, 12, 12}},      {'-', {0, 0, 0, 31, 0, 0, 0}},      {'_', {0, 0, 0, 0, 0, 0, 31}},
-    {':', {0, 12, 12, 0, 12, 12, 0}},    {'/', {1, 1, 2, 4, 8, 16, 16}},     {'(', {2, 4, 8, 8, 8, 4, 2}},
-    {')', {8, 4, 2, 2, 2, 4, 8}},        {',', {0, 0, 0, 0, 12, 4, 8}},      {'+', {0, 4, 4, 31, 4, 4, 0}},
-    {'=', {0, 0, 31, 0, 31, 0, 0}},      {'%', {24, 25, 2, 4, 8, 19, 3}},     {'m', {0, 0, 26, 21, 21, 21, 21}},
-};
-
-const Glyph* glyph(char c) {
-  for (const Glyph& g : kFont)
-    if (g.c == c) return &g;
-  if (c >= 'a' && c <= 'z') return glyph(char(c - 'a' + 'A'));
-  return nullptr;
-}
 
 struct Canvas {
   int width, height;
@@ -71,15 +39,10 @@ struct Canvas {
   }
   // Text from (x, y) at its top left; returns the x after it.
   int text(int x, int y, const std::string& s, const Rgb& c) {
-    for (char ch : s) {
-      if (const Glyph* g = glyph(ch))
-        for (int r = 0; r < kGlyphH; ++r)
-          for (int b = 0; b < kGlyphW; ++b)
-            if (g->rows[r] & (1 << (kGlyphW - 1 - b)))
-              fill(x + b * kFontScale, y + r * kFontScale, x + (b + 1) * kFontScale, y + (r + 1) * kFontScale, c);
-      x += (kGlyphW + 1) * kFontScale;
-    }
-    return x;
+    draw_text(s, [&](int b, int r) {
+      fill(x + b * kFontScale, y + r * kFontScale, x + (b + 1) * kFontScale, y + (r + 1) * kFontScale, c);
+    });
+    return x + int(s.size()) * (kGlyphW + 1) * kFontScale;
   }
   void ring(double cx, double cy, double radius, double thickness, const Rgb& c) {
     const int r = int(std::ceil(radius + thickness));

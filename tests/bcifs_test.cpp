@@ -492,19 +492,28 @@ TEST(Bcifs, PlotDrawsEverySeries) {
   const BoxCount b = box_count_segments(boundary_segments(polygons_of(r.leaves)));
   EXPECT_GT(b.dimension, 1.0);
   EXPECT_LT(b.dimension, 2.0);
-  const std::vector<uint8_t> rgb = plot_measures(m, b, 400, 200);
-  ASSERT_EQ(rgb.size(), 3u * 400 * 200);
-  int red = 0, blue = 0, green = 0, black = 0;
+  const Lacunarity l = lacunarity(r.rules, r.rules.roots[0], 10);
+  const std::vector<uint8_t> rgb = plot_measures(m, b, l.ratio, l.limit, 900, 300);
+  ASSERT_EQ(rgb.size(), 3u * 900 * 300);
+  int red = 0, blue = 0, green = 0, black = 0, purple = 0;
   for (size_t i = 0; i < rgb.size(); i += 3) {
     red += rgb[i] == 220 && rgb[i + 1] == 0 && rgb[i + 2] == 0;
     blue += rgb[i] == 0 && rgb[i + 1] == 0 && rgb[i + 2] == 220;
     green += rgb[i] == 0 && rgb[i + 1] == 160 && rgb[i + 2] == 0;
     black += rgb[i] == 0 && rgb[i + 1] == 0 && rgb[i + 2] == 0;
+    purple += rgb[i] == 140 && rgb[i + 1] == 0 && rgb[i + 2] == 170;
   }
-  EXPECT_GE(red, 4 * 49);  // four markers of 7 x 7 at least
-  EXPECT_GE(blue, 4 * 49);
+  EXPECT_GE(red, 5 * 49);  // four markers of 7 x 7 and the legend's at least
+  EXPECT_GE(blue, 5 * 49);
   EXPECT_GT(green, 100);
   EXPECT_GE(black, 7 * 49);
+  EXPECT_GE(purple, 12 * 49);  // R_0 .. R_10 and the legend
+  // The labels are drawn: the same plot without its ratio panel has fewer black cells (axes, titles).
+  const std::vector<uint8_t> bare = plot_measures(m, b, {}, 0, 900, 300);
+  int bare_black = 0;
+  for (size_t i = 0; i < bare.size(); i += 3) bare_black += bare[i] == 0 && bare[i + 1] == 0 && bare[i + 2] == 0;
+  EXPECT_LT(bare_black, black);
+  EXPECT_THROW(plot_measures(m, b, {}, 0, 200, 100), InvalidInput);
 }
 
 // ---- curved edges ----

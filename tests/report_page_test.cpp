@@ -148,11 +148,11 @@ TEST(ReportPage, InputFiguresOfPlatesAndPatterns) {
   // quarter of, so 9/4 of the motifs the report counts.
   EXPECT_EQ(pictures[0]["type"], "image/svg+xml");
   const std::string svg = unbase64(pictures[0]["data"].get<std::string>());
-  // The plate: its density map (1024 x 1024) and its measure plot (800 x 400), as PNG.
+  // The plate: its density map (1024 x 1024) and its measure plot (1200 x 400), as PNG.
   EXPECT_EQ(pictures[1]["type"], "image/png");
   EXPECT_EQ(pictures[1]["caption"], "plate: density at level 2 (windows of 31 of 1024 pixels)");
   EXPECT_EQ(png_size(unbase64(pictures[1]["data"].get<std::string>())), (std::pair<uint32_t, uint32_t>{1024, 1024}));
-  EXPECT_EQ(png_size(unbase64(pictures[2]["data"].get<std::string>())), (std::pair<uint32_t, uint32_t>{800, 400}));
+  EXPECT_EQ(png_size(unbase64(pictures[2]["data"].get<std::string>())), (std::pair<uint32_t, uint32_t>{1200, 400}));
   const nlohmann::json inputs = to_json(report)["inputs"];
   const size_t motifs = inputs["holes"]["motifs"].get<size_t>();
   ASSERT_EQ(motifs % 4, 0u);

@@ -11,6 +11,7 @@
 #include <tuple>
 
 #include "errors.h"
+#include "util/bitmap_font.h"
 
 namespace lacuna {
 namespace bcifs {
@@ -483,6 +484,7 @@ GeometricMeasures geometric_measures(const RuleSet& rules, std::vector<Leaf> lea
     out.area.push_back(area);
     out.perimeter.push_back(union_perimeter(polygons));
   }
+  out.first_level = first;
   if (last > first) {
     out.area_factor = std::pow(out.area.back() / out.area.front(), 1.0 / (last - first));
     out.perimeter_factor = std::pow(out.perimeter.back() / out.perimeter.front(), 1.0 / (last - first));
@@ -722,28 +724,62 @@ void write_png(const std::string& path, int width, int height, const std::vector
   if (!file) throw IoError("cannot write '" + path + "'");
 }
 
-std::vector<uint8_t> plot_measures(const GeometricMeasures& measures, const BoxCount& boxes, int width, int height) {
-  if (width < 40 || height < 20) throw InvalidInput("plot_measures: the image must be at least 40 x 20");
+std::vector<uint8_t> plot_measures(const GeometricMeasures& measures, const BoxCount& boxes,
+                                   const std::vector<double>& ratio, double ratio_limit, int width, int height) {
+  if (width < 300 || height < 150) throw InvalidInput("plot_measures: the image must be at least 300 x 150");
   Canvas canvas{width, height, std::vector<uint8_t>(3 * size_t(width) * size_t(height), 255)};
-  const std::array<uint8_t, 3> black{0, 0, 0}, red{220, 0, 0}, blue{0, 0, 220}, green{0, 160, 0};
-  const int margin = 10, panel = width / 2;
-  // One panel: data ranges mapped to [x0 + margin, x1 - margin] x [margin, height - margin].
+  const std::array<uint8_t, 3> black{0, 0, 0}, red{220, 0, 0}, blue{0, 0, 220}, green{0, 160, 0}, purple{140, 0, 170},
+      grey{150, 150, 150};
+  const int panel = width / 3;
+  const int left_margin = 40, right_margin = 12, bottom_margin = 30, top_margin = 34;
+  // Text with its top left at (x, y_top) in the canvas's y-up coordinates.
+  auto text = [&](int x, int y_top, const std::string& s, std::array<uint8_t, 3> c) {
+    draw_text(s, [&](int column, int row) { canvas.set(x + column, y_top - row, c); });
+  };
+  auto number = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3g", v);
+    return std::string(buf);
+  };
+  // One panel: data ranges mapped into the panel inside its margins.
   struct Frame {
     double x0, x1, y0, y1;  // data range
     int px0, px1, py0, py1;
     double x(double v) const { return px0 + (v - x0) / (x1 - x0) * (px1 - px0); }
     double y(double v) const { return py0 + (v - y0) / (y1 - y0) * (py1 - py0); }
   };
-  auto make_frame = [&](double x0, double x1, double y0, double y1, int left) {
+  auto make_frame = [&](double x0, double x1, double y0, double y1, int index, const std::string& title,
+                        const std::string& x_label, const std::string& y_label) {
     if (!(x1 > x0)) x1 = x0 + 1;
     if (!(y1 > y0)) y1 = y0 + 1;
-    return Frame{x0, x1, y0, y1, left + margin, left + panel - margin, margin, height - margin};
-  };
-  auto axes = [&](const Frame& f) {
+    const int left = index * panel;
+    Frame f{x0, x1, y0, y1, left + left_margin, left + panel - right_margin, bottom_margin, height - top_margin};
     canvas.line(f.px0, f.py0, f.px1, f.py0, black);
     canvas.line(f.px0, f.py0, f.px0, f.py1, black);
+    text(left + left_margin, height - 4, title, black);
+    text(left + left_margin, height - 4 - kGlyphHeight - 4, y_label, black);
+    text(f.px1 - text_cells(x_label), bottom_margin - 14, x_label, black);
+    // The ranges at the axes' ends.
+    text(f.px0 - 2, bottom_margin - 4, number(x0), black);
+    text(f.px1 - text_cells(number(x1)) - text_cells(x_label) - 10, bottom_margin - 4, number(x1), black);
+    text(left + 2, f.py0 + kGlyphHeight, number(y0), black);
+    text(left + 2, f.py1, number(y1), black);
+    return f;
   };
-  // Left: ln(A_i / A_0) and ln(P_i / P_0).
+  // Legends sit in a corner the series leave free: top left, or bottom right.
+  auto legend = [&](const Frame& f, int row, const std::string& label, std::array<uint8_t, 3> c, bool bottom_right) {
+    const int y = bottom_right ? f.py0 + 8 + (1 - row) * (kGlyphHeight + 5) + kGlyphHeight : f.py1 - 4 - row * (kGlyphHeight + 5);
+    const int x = bottom_right ? f.px1 - text_cells(label) : f.px0 + 24;
+    canvas.marker(x - 12, y - kGlyphHeight / 2, c);
+    text(x, y, label, c);
+  };
+  auto series = [&](const Frame& f, const std::vector<double>& v, double first, std::array<uint8_t, 3> c) {
+    for (size_t i = 0; i < v.size(); ++i) {
+      canvas.marker(f.x(first + double(i)), f.y(v[i]), c);
+      if (i > 0) canvas.line(f.x(first + double(i - 1)), f.y(v[i - 1]), f.x(first + double(i)), f.y(v[i]), c);
+    }
+  };
+  // Left: ln(A_i / A_first) and ln(P_i / P_first) against the level.
   std::vector<double> la, lp;
   for (size_t i = 0; i < measures.area.size(); ++i) {
     la.push_back(std::log(measures.area[i] / measures.area[0]));
@@ -752,29 +788,39 @@ std::vector<uint8_t> plot_measures(const GeometricMeasures& measures, const BoxC
   double lo = 0, hi = 0;
   for (double v : la) lo = std::min(lo, v), hi = std::max(hi, v);
   for (double v : lp) lo = std::min(lo, v), hi = std::max(hi, v);
-  const Frame left = make_frame(0, std::max(1.0, double(la.size()) - 1), lo, hi, 0);
-  axes(left);
-  for (const auto& series : {std::make_pair(&la, red), std::make_pair(&lp, blue)}) {
-    const std::vector<double>& v = *series.first;
-    for (size_t i = 0; i < v.size(); ++i) {
-      canvas.marker(left.x(double(i)), left.y(v[i]), series.second);
-      if (i > 0) canvas.line(left.x(double(i - 1)), left.y(v[i - 1]), left.x(double(i)), left.y(v[i]), series.second);
-    }
-  }
-  // Right: ln N against ln(1/eps), and the fitted line through the mean point.
+  const double first = measures.first_level;
+  const Frame left = make_frame(first, first + std::max(1.0, double(la.size()) - 1), lo, hi, 0, "AREA, PERIMETER", "LEVEL I",
+                                "LN(A_I/A_0), LN(P_I/P_0)");
+  series(left, la, first, red);
+  series(left, lp, first, blue);
+  legend(left, 0, "AREA", red, false);
+  legend(left, 1, "PERIMETER", blue, false);
+  // Middle: ln N against ln(1/eps), and the fitted line through the mean point.
   if (!boxes.log_count.empty()) {
     const auto [xmin, xmax] = std::minmax_element(boxes.log_inverse_size.begin(), boxes.log_inverse_size.end());
     const auto [ymin, ymax] = std::minmax_element(boxes.log_count.begin(), boxes.log_count.end());
-    const Frame right = make_frame(*xmin, *xmax, *ymin, *ymax, panel);
-    axes(right);
+    const Frame middle = make_frame(*xmin, *xmax, *ymin, *ymax, 1, "BOX COUNTING", "LN(1/E)", "LN N");
     double mx = 0, my = 0;
     for (size_t i = 0; i < boxes.log_count.size(); ++i) mx += boxes.log_inverse_size[i], my += boxes.log_count[i];
     mx /= double(boxes.log_count.size());
     my /= double(boxes.log_count.size());
-    canvas.line(right.x(*xmin), right.y(my + boxes.dimension * (*xmin - mx)), right.x(*xmax),
-                right.y(my + boxes.dimension * (*xmax - mx)), green);
+    canvas.line(middle.x(*xmin), middle.y(my + boxes.dimension * (*xmin - mx)), middle.x(*xmax),
+                middle.y(my + boxes.dimension * (*xmax - mx)), green);
     for (size_t i = 0; i < boxes.log_count.size(); ++i)
-      canvas.marker(right.x(boxes.log_inverse_size[i]), right.y(boxes.log_count[i]), black);
+      canvas.marker(middle.x(boxes.log_inverse_size[i]), middle.y(boxes.log_count[i]), black);
+    legend(middle, 0, "BOXES", black, false);
+    legend(middle, 1, "D = " + number(boxes.dimension), green, false);
+  }
+  // Right: R_i = N^L_i / (N^C_i + N^L_i) against the level, and its limit.
+  if (!ratio.empty()) {
+    double rhi = ratio_limit;
+    for (double v : ratio) rhi = std::max(rhi, v);
+    const Frame right = make_frame(0, std::max(1.0, double(ratio.size()) - 1), 0, rhi * 1.1 + 1e-12, 2, "LACUNARITY",
+                                   "LEVEL I", "R_I");
+    for (int x = right.px0; x < right.px1; x += 6) canvas.line(x, right.y(ratio_limit), x + 3, right.y(ratio_limit), grey);
+    series(right, ratio, 0, purple);
+    legend(right, 0, "R_I", purple, true);
+    legend(right, 1, "R = " + number(ratio_limit), grey, true);
   }
   return canvas.rgb;
 }

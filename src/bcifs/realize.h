@@ -122,6 +122,7 @@ struct GeometricMeasures {
   std::vector<double> perimeter;  // P_i: length of the union's boundary
   double area_factor = 0;         // F_A = (A_levels / A_0)^(1 / levels): geometric mean of A_(i+1) / A_i
   double perimeter_factor = 0;    // F_P likewise
+  int first_level = 0;            // the level of area[0]
 };
 
 GeometricMeasures geometric_measures(const RuleSet& rules, int type, const std::vector<Vec2d>& control, int levels,
@@ -183,9 +184,12 @@ std::vector<uint8_t> encode_png(int width, int height, const std::vector<uint8_t
 // Throws IoError when the file cannot be written.
 void write_png(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb, int level = 0);
 
-// A two-panel plot, RGB width x height: left ln(A_i/A_0) (red) and ln(P_i/P_0) (blue) against i with markers;
-// right the box-counting points (black) and their fitted line (green). Axes in black, no text.
-std::vector<uint8_t> plot_measures(const GeometricMeasures& measures, const BoxCount& boxes, int width, int height);
+// A three-panel plot, RGB width x height (at least 300 x 150), each panel titled, its axes labelled
+// with their ranges and a legend: left ln(A_i/A_first) (red) and ln(P_i/P_first) (blue) against the
+// level; middle the box-counting points (black) and their fitted line (green, D); right R_i (purple)
+// against the level, to level ratio.size() - 1, and its limit R (grey, dashed).
+std::vector<uint8_t> plot_measures(const GeometricMeasures& measures, const BoxCount& boxes,
+                                   const std::vector<double>& ratio, double ratio_limit, int width, int height);
 
 }  // namespace bcifs
 }  // namespace lacuna

@@ -74,7 +74,9 @@ std::pair<int, int> parse_levels(const std::string& text) {
   } else if (!(in >> hi)) {
     throw InvalidInput("--levels: expected \"A..B\" such as 0..5, got \"" + text + "\"");
   }
-  if (lo < 0 || hi < lo || hi > 8) throw InvalidInput("--levels: expected 0 <= A <= B <= 8, got \"" + text + "\"");
+  if (lo < 0 || hi < lo || hi > kMaxTopologyLevel || lo > kMaxGeometryLevel)
+    throw InvalidInput("--levels: expected 0 <= A <= B <= 12 and A <= 8 (areas and box counting to 8, counts to 12), got \"" +
+                       text + "\"");
   return {lo, hi};
 }
 
@@ -105,6 +107,7 @@ int bcifs_measure(const BcifsArgs& a) {
     const bcifs::BoxCount& region = measures.region;
     const bcifs::BoxCount& boundary = measures.boundary;
     entry["levels"] = {lo, hi};
+    entry["geometry_levels"] = {lo, std::min(hi, kMaxGeometryLevel)};
     entry["area_mm2"] = m.area;
     entry["perimeter_mm"] = m.perimeter;
     entry["F_A"] = m.area_factor;
@@ -173,7 +176,9 @@ std::function<int()> add_bcifs_commands(CLI::App& app) {
   CLI::App* measure = bcifs->add_subcommand(
       "measure", "Topological and geometric measures of the bcifs_plate inputs of a recipe, with density maps and plots");
   measure->add_option("recipe", args->recipe, "Recipe file")->required();
-  measure->add_option("--levels", args->levels, "Levels A..B (default 0..4)");
+  measure->add_option("--levels", args->levels,
+                      "Levels A..B (default 0..4): the counts N^C, N^L, R from 0 to B (at most 12), areas, perimeters "
+                      "and box counting from A to B (at most 8)");
   measure->add_option("-o,--output", args->out_dir, "Folder for the PNG files (default: <recipe>_measures)");
   measure->add_option("--mask-px", args->mask_px, "Side of the density mask in pixels (of 1024)")->check(CLI::Range(1, 1023));
   measure->add_flag("--json", args->json, "Print JSON");

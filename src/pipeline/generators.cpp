@@ -150,9 +150,9 @@ VoronoiCells voronoi_cells(const voronoi::Rules& rules, int level, bool scaled_c
 }
 
 PlateMeasures measure_plate(const bcifs::Plate& plate, int first, int last) {
-  if (first < 0 || last < first || last > 8)
-    throw InvalidInput("levels: expected 0 <= first <= last <= 8, got " + std::to_string(first) + ".." +
-                       std::to_string(last));
+  if (first < 0 || last < first || last > kMaxTopologyLevel || first > kMaxGeometryLevel)
+    throw InvalidInput("levels: expected 0 <= first <= last <= " + std::to_string(kMaxTopologyLevel) + " and first <= " +
+                       std::to_string(kMaxGeometryLevel) + ", got " + std::to_string(first) + ".." + std::to_string(last));
   const bcifs::PlateOptions& spec = plate.options;
   PlateMeasures m;
   for (size_t f = 0; f < spec.assembly.faces.size(); ++f) {
@@ -162,7 +162,9 @@ PlateMeasures measure_plate(const bcifs::Plate& plate, int first, int last) {
   std::vector<bcifs::Leaf> faces_at_level_0;
   for (auto& face : bcifs::realize_assembly(plate.rules, spec.assembly, spec.controls, 0, spec.options, spec.bends))
     faces_at_level_0.insert(faces_at_level_0.end(), face.begin(), face.end());
-  m.geometry = bcifs::geometric_measures(plate.rules, faces_at_level_0, first, last, spec.options, &m.polygons);
+  // The realization to level 8 at most; the counts (no geometry) to `last`.
+  m.geometry = bcifs::geometric_measures(plate.rules, faces_at_level_0, first, std::min(last, kMaxGeometryLevel),
+                                         spec.options, &m.polygons);
   m.region = bcifs::box_count_region(m.polygons);
   m.boundary = bcifs::box_count_segments(bcifs::boundary_segments(m.polygons));
   return m;

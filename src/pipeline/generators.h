@@ -90,16 +90,21 @@ VoronoiCells voronoi_cells(const voronoi::Rules& rules, int level, bool scaled_c
 
 // What `bcifs measure` finds for one plate between two levels.
 struct PlateMeasures {
-  std::vector<bcifs::Lacunarity> faces;      // per face of the assembly, its counts at levels 0 .. last
+  std::vector<bcifs::Lacunarity> faces;      // per face of the assembly, its counts at levels 0 .. last (to 12)
   std::vector<int> face_types;               // per face, its type in the rule set
-  bcifs::GeometricMeasures geometry;         // areas and perimeters of levels first .. last
+  bcifs::GeometricMeasures geometry;         // areas and perimeters of levels first .. min(last, 8)
   bcifs::BoxCount region;                    // box counting of the region at the last level
   bcifs::BoxCount boundary;                  // and of its boundary
   std::vector<std::vector<Vec2d>> polygons;  // the sub-faces of the last level (mm)
 };
 
-// Measures the plate between levels `first` and `last` (0 <= first <= last <= 8). Throws InvalidInput
-// for other levels.
+// The deepest levels measured: the counts N^C_i, N^L_i, R_i need only the rules; areas, perimeters and
+// box counting realize every sub-face.
+constexpr int kMaxTopologyLevel = 12;
+constexpr int kMaxGeometryLevel = 8;
+
+// Measures the plate: its counts from level 0 to `last`, its geometry from `first` to min(last, 8)
+// (0 <= first <= 8, first <= last <= 12). Throws InvalidInput for other levels.
 PlateMeasures measure_plate(const bcifs::Plate& plate, int first, int last);
 
 }  // namespace lacuna

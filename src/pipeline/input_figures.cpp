@@ -30,7 +30,10 @@ PlateImages plate_images(const PlateMeasures& measures, int mask_px) {
   const std::vector<uint8_t> density = bcifs::density_colours(bcifs::density_map(mask, kSide, kSide, mask_px));
   PlateImages images;
   images.density_png = bcifs::encode_png(kSide, kSide, flip_rows(density, kSide, kSide), 6);
-  images.plot_png = bcifs::encode_png(800, 400, bcifs::plot_measures(measures.geometry, measures.boundary, 800, 400), 6);
+  // R_i of the plate's first face.
+  const std::vector<double> ratio = measures.faces.empty() ? std::vector<double>{} : measures.faces[0].ratio;
+  const double limit = measures.faces.empty() ? 0 : measures.faces[0].limit;
+  images.plot_png = bcifs::encode_png(1200, 400, bcifs::plot_measures(measures.geometry, measures.boundary, ratio, limit, 1200, 400), 6);
   return images;
 }
 
@@ -40,9 +43,10 @@ std::vector<InputFigure> input_figures(const BuiltInputs& inputs) {
     const std::string& name = inputs.names[i];
     const BuiltInput& input = inputs.inputs[i];
     if (input.plate) {
-      const int level = std::min(input.plate->options.level, 8);
-      const PlateImages images = plate_images(measure_plate(*input.plate, 0, level));
-      const std::string levels = "levels 0 to " + std::to_string(level);
+      const int level = std::min(input.plate->options.level, kMaxGeometryLevel);
+      // The counts to level 10 at least (they need no geometry), so R_i nears its limit.
+      const PlateImages images = plate_images(measure_plate(*input.plate, 0, std::max(level, 10)));
+      const std::string levels = "levels 0 to " + std::to_string(level) + ", R_i to " + std::to_string(std::max(level, 10));
       figures.push_back({name + ": density at level " + std::to_string(level) + " (windows of 31 of 1024 pixels)",
                          "image/png", as_string(images.density_png)});
       figures.push_back({name + ": area and perimeter, box counting (" + levels + ")", "image/png",

@@ -13,7 +13,7 @@ namespace lacuna {
 
 struct PlateImages {
   std::vector<uint8_t> density_png;  // 1024 x 1024: the last level's local density in windows of mask_px
-  std::vector<uint8_t> plot_png;     // 800 x 400: ln A_i, ln P_i against i, and the box counting
+  std::vector<uint8_t> plot_png;     // 1200 x 400: ln A_i, ln P_i against i, the box counting, R_i of the first face
 };
 
 // The density map and measure plot of a plate's measures.
@@ -25,7 +25,8 @@ struct InputFigure {
   std::string bytes;  // the file's
 };
 
-// Per lacunar plate (measured from level 0 to its own, at most 8) its density map and plot; per
+// Per lacunar plate (its geometry measured from level 0 to its own, at most 8, its counts to 10 or
+// its own level) its density map and plot; per
 // wallpaper pattern its picture over 3 x 3 cells; in the recipe's order.
 std::vector<InputFigure> input_figures(const BuiltInputs& inputs);
 

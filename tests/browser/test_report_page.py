@@ -113,4 +113,4 @@ def test_input_figures_page(tmp_path):
     state = assert_page_matches_report(result, report)
     sizes = {p["caption"].split(":")[0] + (" plot" if "box counting" in p["caption"] else ""): (p["width"], p["height"])
              for p in state["pictures"]}
-    assert sizes == {"holes": (800, 800), "plate": (1024, 1024), "plate plot": (800, 400)}
+    assert sizes == {"holes": (800, 800), "plate": (1024, 1024), "plate plot": (1200, 400)}
