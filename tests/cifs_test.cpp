@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <nlohmann/json.hpp>
 #include <set>
 
 #include "cifs/automaton.h"
@@ -161,6 +162,67 @@ TEST(Nurbs, TessellationVerticesEqualCoxDeBoor) {
     expect_matches_cox_de_boor(d, skewed, points, false, 7);
     expect_matches_cox_de_boor(d, skewed, homogeneous, true, 7);
     expect_matches_cox_de_boor(d, uniform, homogeneous, true, 5);
+  }
+}
+
+// The unit derivative of the piece at x by second-order differences (one-sided at its ends).
+Eigen::Vector3d cox_de_boor_direction(int d, const std::vector<double>& knots, const Eigen::MatrixXd& points,
+                                      bool rational, double x) {
+  const double span = knots[size_t(d)] - knots[size_t(d - 1)], h = 1e-5 * span;
+  auto p = [&](double t) { return de_boor_point(d, knots, points, rational, t); };
+  Eigen::Vector3d v;
+  if (x - h < knots[size_t(d - 1)]) v = -3 * p(x) + 4 * p(x + h) - p(x + 2 * h);
+  else if (x + h > knots[size_t(d)]) v = 3 * p(x) - 4 * p(x - h) + p(x - 2 * h);
+  else v = p(x + h) - p(x - h);
+  return v / v.norm();
+}
+
+TEST(Nurbs, LimitTangentsEqualTheCoxDeBoorDerivative) {
+  for (int d = 2; d <= 4; ++d) {
+    Eigen::MatrixXd points(3, d + 1), homogeneous(4, d + 1);
+    for (int i = 0; i <= d; ++i) {
+      points.col(i) << 10 * std::cos(0.9 * i), 7 * std::sin(1.3 * i) + i, 3.0 * i * i / (d + 1);
+      const double w = 0.5 + 0.4 * (i % 3) + 0.3 * i;
+      homogeneous.col(i) << w * points.col(i), w;
+    }
+    std::vector<double> uniform, skewed{0};
+    for (int i = 0; i < 2 * d; ++i) uniform.push_back(i);
+    for (int i = 1; i < 2 * d; ++i) skewed.push_back(skewed.back() + (i % 2 ? 0.3 : 2.0) * (1 + 0.3 * i));
+    for (const auto& knots : {uniform, skewed})
+      for (bool rational : {false, true}) {
+        Cifs c = nurbs_cifs(d, knots, rational ? homogeneous : points, rational);
+        complete_primitives(c.automaton);
+        const nlohmann::json frames = initial_frames_json(c);
+        ASSERT_EQ(frames.size(), 2u);
+        // Into the piece: along the parameter at its start, against it at its end.
+        const Eigen::Vector3d start = cox_de_boor_direction(d, knots, c.control_points, rational, knots[size_t(d - 1)]);
+        const Eigen::Vector3d end = cox_de_boor_direction(d, knots, c.control_points, rational, knots[size_t(d)]);
+        for (int i = 0; i < 3; ++i) {
+          ASSERT_TRUE(frames[0]["smooth"].get<bool>()) << frames[0].dump();
+          EXPECT_NEAR(frames[0]["tangents"][0][i].get<double>(), start(i), 1e-6) << "degree " << d;
+          EXPECT_NEAR(frames[1]["tangents"][0][i].get<double>(), -end(i), 1e-6) << "degree " << d;
+        }
+        // The rate: the second eigenvalue of a half's matrix, 1/2 for every B-spline.
+        EXPECT_NEAR(frames[0]["rates"][0].get<double>(), 0.5, 1e-9);
+      }
+  }
+}
+
+TEST(Nurbs, PlanarTensorSurfaceHasTheNormalOfItsPlane) {
+  const NurbsAutomaton u = nurbs_automaton(2, {0, 1, 2.5, 3}), v = nurbs_automaton(3, {0, 0.5, 1, 2, 2.2, 4});
+  Cifs c{"patch", tensor_product(u.automaton, v.automaton), Eigen::MatrixXd(3, 3 * 4), false};
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 4; ++b) c.control_points.col(a * 4 + b) << 3.0 * a + 0.4 * b * b, 2.0 * b - 0.3 * a, 0;
+  // Tilt the plane: z = 0.5 x - 0.25 y, normal (0.5, -0.25, -1) normalised up to its sign.
+  c.control_points.row(2) = 0.5 * c.control_points.row(0) - 0.25 * c.control_points.row(1);
+  complete_primitives(c.automaton);
+  const nlohmann::json frames = initial_frames_json(c);
+  ASSERT_EQ(frames.size(), 4u);
+  const Eigen::Vector3d expected = Eigen::Vector3d(0.5, -0.25, -1).normalized();
+  for (const auto& f : frames) {
+    ASSERT_TRUE(f["smooth"].get<bool>()) << f.dump();
+    const Eigen::Vector3d n(f["normal"][0].get<double>(), f["normal"][1].get<double>(), f["normal"][2].get<double>());
+    EXPECT_NEAR(std::abs(n.dot(expected)), 1, 1e-9) << f.dump();
   }
 }
 

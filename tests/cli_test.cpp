@@ -315,6 +315,14 @@ TEST(Cli, CifsAndNurbsInspection) {
   EXPECT_NEAR(p["points"][8][0].get<double>(), 1.0, 1e-14);
   EXPECT_NEAR(p["points"][8][1].get<double>(), 1.5, 1e-14);
   EXPECT_NEAR(p["points"][16][0].get<double>(), 1.5, 1e-14);
+  // Tangents from the automaton: C'(s) = (1 - s)(P1 - P0) + s (P2 - P1) = (1, 2 - 4 s) at s = k / 16.
+  ASSERT_EQ(p["tangents"].size(), 17u);
+  for (size_t k = 0; k < 17; ++k) {
+    const double s = double(k) / 16, length = std::hypot(1.0, 2 - 4 * s);
+    EXPECT_NEAR(p["tangents"][k][0].get<double>(), 1 / length, 1e-9) << k;
+    EXPECT_NEAR(p["tangents"][k][1].get<double>(), (2 - 4 * s) / length, 1e-9) << k;
+    EXPECT_NEAR(p["tangents"][k][2].get<double>(), 0, 1e-12) << k;
+  }
 
   Result info = lacuna("cifs info menger_sponge --json", dir.path());
   ASSERT_EQ(info.code, 0) << info.err;
@@ -322,6 +330,12 @@ TEST(Cli, CifsAndNurbsInspection) {
   EXPECT_EQ(i["states"].size(), 1u);
   EXPECT_EQ(i["transitions"].size(), 20u);
   EXPECT_TRUE(i["states"][0]["stationary"].get<bool>());
+  // A Takagi curve has no tangent at its ends (its loop's two eigenvalues are both 1/2); a B-spline has.
+  const nlohmann::json takagi = nlohmann::json::parse(lacuna("cifs info takagi_curve --json", dir.path()).out);
+  for (const auto& f : takagi["limit_frames"]) EXPECT_FALSE(f["smooth"].get<bool>()) << f.dump();
+  const nlohmann::json cubic = nlohmann::json::parse(lacuna("cifs info bspline_cubic --json", dir.path()).out);
+  ASSERT_EQ(cubic["limit_frames"].size(), 2u);
+  for (const auto& f : cubic["limit_frames"]) EXPECT_TRUE(f["smooth"].get<bool>()) << f.dump();
 
   Result koch = lacuna("cifs tessellate koch_curve --level 2 --format json", dir.path());
   ASSERT_EQ(koch.code, 0) << koch.err;

@@ -1,6 +1,7 @@
 #include "cifs/automaton.h"
 
 #include <cmath>
+#include <complex>
 #include <map>
 #include <string>
 
@@ -194,6 +195,96 @@ Eigen::VectorXd limit_point(const Automaton& a, int state, int symbol) {
       for (size_t s = loop_start; s-- > 0;) x = steps[s]->matrix * x;
       return x;
     }
+  }
+}
+
+FixedPointFrame fixed_point_frame(const Eigen::MatrixXd& m, int dimension, const Eigen::VectorXd& toward) {
+  FixedPointFrame frame;
+  frame.point = fixed_point(m);
+  const Eigen::Index k = m.rows();
+  if (dimension < 1 || dimension > 2 || k < dimension + 1) {
+    frame.reason = "no tangents for an attractor of dimension " + std::to_string(dimension) + " on " +
+                   std::to_string(k) + " control points";
+    return frame;
+  }
+  // An orthonormal basis of the differences (vectors summing to 0): the complement of (1, ..., 1).
+  const Eigen::MatrixXd ones = Eigen::MatrixXd::Ones(k, 1);
+  const Eigen::MatrixXd basis = Eigen::HouseholderQR<Eigen::MatrixXd>(ones).householderQ();
+  const Eigen::MatrixXd q = basis.rightCols(k - 1);
+  const Eigen::MatrixXd restricted = q.transpose() * m * q;
+  Eigen::EigenSolver<Eigen::MatrixXd> eigen(restricted);
+  if (eigen.info() != Eigen::Success) {
+    frame.reason = "the loop's eigenvalues did not converge";
+    return frame;
+  }
+  std::vector<Eigen::Index> order(size_t(k - 1));
+  for (Eigen::Index i = 0; i < k - 1; ++i) order[size_t(i)] = i;
+  const Eigen::VectorXcd values = eigen.eigenvalues();
+  std::stable_sort(order.begin(), order.end(), [&](Eigen::Index a, Eigen::Index b) { return std::abs(values(a)) > std::abs(values(b)); });
+  // A repeated (or defective) eigenvalue first: its numerical pair may carry a small imaginary part.
+  const double tolerance = 1e-9 * (1 + std::abs(values(order[0])));
+  if (Eigen::Index(dimension) < k - 1 &&
+      std::abs(values(order[size_t(dimension)])) > std::abs(values(order[size_t(dimension - 1)])) * (1 - 1e-6)) {
+    frame.reason = "the loop's eigenvalue " + std::to_string(dimension + 1) + " is as large as eigenvalue " +
+                   std::to_string(dimension) + " (after 1): no single tangent " + std::string(dimension == 1 ? "line" : "plane");
+    return frame;
+  }
+  for (int i = 0; i < dimension; ++i) {
+    const std::complex<double> v = values(order[size_t(i)]);
+    if (std::abs(v.imag()) > tolerance) {
+      frame.reason = "the loop's eigenvalue " + std::to_string(i + 2) + " is complex: the attractor turns around the point";
+      return frame;
+    }
+  }
+  // Orientation: the components of (toward - point) along the eigenvectors.
+  const Eigen::MatrixXcd vectors = eigen.eigenvectors();
+  const Eigen::VectorXcd along = vectors.fullPivLu().solve((q.transpose() * (toward - frame.point)).cast<std::complex<double>>());
+  for (int i = 0; i < dimension; ++i) {
+    Eigen::VectorXd d = q * vectors.col(order[size_t(i)]).real();
+    if (along(order[size_t(i)]).real() < 0) d = -d;
+    frame.directions.push_back(d / d.norm());
+    frame.rates.push_back(values(order[size_t(i)]).real());
+  }
+  frame.smooth = true;
+  return frame;
+}
+
+FixedPointFrame limit_frame(const Automaton& a, int state, int symbol, int dimension, const Eigen::VectorXd& toward) {
+  std::vector<int> path{state};
+  std::vector<const Transition*> steps;
+  std::map<int, size_t> seen{{state, 0}};
+  for (;;) {
+    const Transition* t = find_transition(a, path.back(), symbol);
+    if (!t)
+      throw InvalidInput(state_label(a, path.back()) + " has no transition on symbol " + std::to_string(symbol) +
+                         " to follow to its limit point");
+    steps.push_back(t);
+    auto [it, fresh] = seen.emplace(t->target, path.size());
+    path.push_back(t->target);
+    if (fresh) continue;
+    const size_t loop_start = it->second;
+    const int k = a.states[size_t(path[loop_start])].control_points;
+    Eigen::MatrixXd loop = Eigen::MatrixXd::Identity(k, k), prefix = Eigen::MatrixXd::Identity(a.states[size_t(state)].control_points, a.states[size_t(state)].control_points);
+    for (size_t s = loop_start; s < steps.size(); ++s) loop = loop * steps[s]->matrix;
+    for (size_t s = 0; s < loop_start; ++s) prefix = prefix * steps[s]->matrix;
+    // `toward` seen from the loop's state: its preimage is not needed, only an attractor point
+    // there on the same side; the loop's own other end (the limit of another symbol) serves.
+    Eigen::VectorXd toward_loop;
+    if (loop_start == 0) {
+      toward_loop = toward;
+    } else {
+      const Transition& other = a.transitions[size_t(path[loop_start])].front().symbol == symbol
+                                    ? a.transitions[size_t(path[loop_start])].back()
+                                    : a.transitions[size_t(path[loop_start])].front();
+      toward_loop = limit_point(a, path[loop_start], other.symbol);
+    }
+    FixedPointFrame frame = fixed_point_frame(loop, dimension, toward_loop);
+    frame.point = prefix * frame.point;
+    for (Eigen::VectorXd& d : frame.directions) {
+      d = prefix * d;
+      d /= d.norm();
+    }
+    return frame;
   }
 }
 

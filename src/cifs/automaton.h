@@ -69,6 +69,29 @@ Eigen::VectorXd fixed_point(const Eigen::MatrixXd& matrix);
 // Throws InvalidInput if the symbol is undefined on the way.
 Eigen::VectorXd limit_point(const Automaton& automaton, int state, int symbol);
 
+// The attractor near a fixed point: the loop's matrix M maps differences of barycentric points (their
+// coordinates sum to 0) to differences, and the attractor approaches the fixed point along the
+// eigenvectors of M's largest eigenvalues on that space. A curve has a tangent there when the
+// largest is real and simple (strictly larger in modulus than the next), a surface a tangent plane
+// when the two largest are real and larger than the third.
+struct FixedPointFrame {
+  Eigen::VectorXd point;                    // barycentric
+  std::vector<Eigen::VectorXd> directions;  // `dimension` difference vectors into the attractor (smooth only)
+  std::vector<double> rates;                // their eigenvalues
+  bool smooth = false;
+  std::string reason;                       // why not smooth
+};
+
+// The frame of the fixed point of `matrix` for an attractor of `dimension` 1 or 2; each direction
+// is oriented so that `toward` (another barycentric point of the attractor) lies on its positive
+// side. Throws as fixed_point().
+FixedPointFrame fixed_point_frame(const Eigen::MatrixXd& matrix, int dimension, const Eigen::VectorXd& toward);
+
+// The frame at limit_point(automaton, state, symbol): the loop's frame mapped back along the way.
+// `toward` is a barycentric point of `state`'s attractor other than the limit point.
+FixedPointFrame limit_frame(const Automaton& automaton, int state, int symbol, int dimension,
+                            const Eigen::VectorXd& toward);
+
 // The vertices of every state's primitive: those given, or for segments the end points (first and
 // last symbol repeated), for quads of a tensor product the four corners. Fills State::vertices.
 void complete_primitives(Automaton& automaton);

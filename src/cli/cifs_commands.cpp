@@ -70,6 +70,12 @@ int cifs_info(const CifsArgs& args) {
                 s["stationary"].get<bool>() ? ", stationary" : "");
     for (const auto& f : s["fixed_points"]) std::printf("    fixed point of symbol %d: %s\n", f["symbol"].get<int>(), f["barycentric"].dump().c_str());
   }
+  for (const auto& f : j["limit_frames"]) {
+    std::printf("  limit of symbol %d^w at %s: ", f["symbol"].get<int>(), f.value("point_mm", nlohmann::json()).dump().c_str());
+    if (!f["smooth"].get<bool>()) std::printf("not smooth (%s)\n", f["reason"].get<std::string>().c_str());
+    else if (f.contains("normal")) std::printf("tangents %s, normal %s\n", f["tangents"].dump().c_str(), f["normal"].dump().c_str());
+    else std::printf("tangent %s\n", f["tangents"][0].dump().c_str());
+  }
   for (const auto& t : j["transitions"])
     std::printf("  %d --%d--> %d\n", t["from"].get<int>(), t["symbol"].get<int>(), t["to"].get<int>());
   return kExitOk;
@@ -155,6 +161,10 @@ int nurbs_tessellate_command(const NurbsArgs& args) {
   nlohmann::json out = {{"degree", args.degree}, {"level", args.level}, {"points", nlohmann::json::array()},
                         {"parameters", curve.parameters}};
   for (const Vec3d& p : curve.points_mm) out["points"].push_back(point_json(p));
+  if (!curve.tangents.empty()) {
+    out["tangents"] = nlohmann::json::array();
+    for (const Vec3d& t : curve.tangents) out["tangents"].push_back(point_json(t));
+  }
   if (args.json) {
     std::cout << out.dump() << "\n";
   } else {

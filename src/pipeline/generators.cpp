@@ -1,7 +1,9 @@
 #include "pipeline/generators.h"
 
 #include <cmath>
+#include <functional>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <utility>
 
 #include "cifs/nurbs.h"
@@ -64,6 +66,47 @@ NurbsCurvePoints nurbs_curve_points(int degree, const std::vector<double>& knots
       out.points_mm.push_back(p);
       out.parameters.push_back(cifs::nurbs_vertex_parameter(degree, knots, level, i++));
     }
+  if (level > 16) return out;
+  // Per state, its start tangent (the limit frame of its left half, into the piece) and end tangent
+  // (of its right half, into the piece, so reversed); sub-pieces in address order, left first.
+  cifs::Automaton a = c.automaton;
+  cifs::complete_primitives(a);
+  std::vector<std::optional<cifs::FixedPointFrame>> starts(a.states.size()), ends(a.states.size());
+  auto frame = [&](std::vector<std::optional<cifs::FixedPointFrame>>& cache, int state, int symbol, int toward) {
+    if (!cache[size_t(state)])
+      cache[size_t(state)] = cifs::limit_frame(a, state, symbol, 1, a.states[size_t(state)].vertices.col(toward));
+    return *cache[size_t(state)];
+  };
+  auto tangent = [&](const Eigen::MatrixXd& word, const cifs::FixedPointFrame& f, double sign) {
+    if (!f.smooth) return Vec3d{0, 0, 0};
+    const Eigen::VectorXd x = word * f.point, d = word * f.directions[0];
+    const Eigen::VectorXd h = c.control_points * x, dh = c.control_points * d;
+    Eigen::Vector3d v = c.rational ? Eigen::Vector3d(dh.head<3>() / h(3) - h.head<3>() * dh(3) / (h(3) * h(3)))
+                                   : Eigen::Vector3d(dh.head<3>());
+    v *= sign / v.norm();
+    return Vec3d{v.x(), v.y(), v.z()};
+  };
+  std::function<void(int, const Eigen::MatrixXd&, int)> visit = [&](int state, const Eigen::MatrixXd& word, int depth) {
+    if (depth == level) {
+      out.tangents.push_back(tangent(word, frame(starts, state, 0, 1), 1));
+      return;
+    }
+    for (int symbol : {0, 1}) {
+      const cifs::Transition* t = cifs::find_transition(a, state, symbol);
+      visit(t->target, word * t->matrix, depth + 1);
+    }
+  };
+  const int k = a.states[size_t(a.initial)].control_points;
+  visit(a.initial, Eigen::MatrixXd::Identity(k, k), 0);
+  // The last point: the end of the last sub-piece.
+  Eigen::MatrixXd word = Eigen::MatrixXd::Identity(k, k);
+  int state = a.initial;
+  for (int depth = 0; depth < level; ++depth) {
+    const cifs::Transition* t = cifs::find_transition(a, state, 1);
+    word = word * t->matrix;
+    state = t->target;
+  }
+  out.tangents.push_back(tangent(word, frame(ends, state, 1, 0), -1));
   return out;
 }
 

@@ -41,6 +41,9 @@ CifsTessellation tessellate_system(cifs::Cifs system, int level);
 struct NurbsCurvePoints {
   std::vector<Vec3d> points_mm;
   std::vector<double> parameters;
+  // Levels up to 16: the unit tangent at every point along increasing parameter, from the automaton
+  // (the limit frame of the sub-piece the point starts, or ends for the last point).
+  std::vector<Vec3d> tangents;
 };
 
 // The piece of `degree` with its 2 degree knots and control points (a JSON list of degree + 1 points

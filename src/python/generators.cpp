@@ -240,10 +240,12 @@ void add_generators(py::module_& m) {
         py::dict d;
         d["points"] = points_array(r.points_mm);
         d["parameters"] = numbers_array(r.parameters);
+        if (!r.tangents.empty()) d["tangents"] = points_array(r.tangents);
         return d;
       },
       py::arg("degree"), py::arg("knots"), py::arg("control_points"), py::arg("level") = 4,
-      "One NURBS piece evaluated by its automaton: points (2^level + 1 of them, mm) and their parameters. "
+      "One NURBS piece evaluated by its automaton: points (2^level + 1 of them, mm), their parameters and (levels "
+      "up to 16) their unit tangents along the parameter, from the automaton's limit frames. "
       "control_points: degree + 1 rows [x, y, z], or [x, y, z, w] for a rational curve.");
   m.def(
       "curve_points",

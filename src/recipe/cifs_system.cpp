@@ -284,6 +284,66 @@ Cifs load_system(const std::string& name_or_file) {
   return parse_system(read_json_file(name_or_file, "a system file (.json)"), name_or_file, "");
 }
 
+namespace {
+
+// A barycentric point of the initial state's space, in mm (rational systems: homogeneous divided).
+Eigen::Vector3d space_point(const Cifs& c, const Eigen::VectorXd& x) {
+  const Eigen::VectorXd h = c.control_points * x;
+  return c.rational ? Eigen::Vector3d(h.head<3>() / h(3)) : Eigen::Vector3d(h.head<3>());
+}
+
+// The unit direction in space of a barycentric direction d at the point x (the projection's
+// derivative for rational systems).
+Eigen::Vector3d space_direction(const Cifs& c, const Eigen::VectorXd& x, const Eigen::VectorXd& d) {
+  const Eigen::VectorXd h = c.control_points * x, dh = c.control_points * d;
+  Eigen::Vector3d v = c.rational ? Eigen::Vector3d(dh.head<3>() / h(3) - h.head<3>() * dh(3) / (h(3) * h(3)))
+                                 : Eigen::Vector3d(dh.head<3>());
+  return v.norm() > 0 ? Eigen::Vector3d(v / v.norm()) : v;
+}
+
+std::vector<double> as_list(const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
+
+}  // namespace
+
+nlohmann::json initial_frames_json(const Cifs& c) {
+  const Automaton& a = c.automaton;
+  const State& s = a.states[size_t(a.initial)];
+  const int dimension = primitive_dimension(s.primitive);
+  nlohmann::json frames = nlohmann::json::array();
+  if (dimension < 1 || dimension > 2 || s.vertices.cols() == 0) return frames;
+  // Orientation: into the primitive, towards the mean of its vertices.
+  const Eigen::VectorXd inside = s.vertices.rowwise().mean();
+  for (const Transition& t : a.transitions[size_t(a.initial)]) {
+    nlohmann::json f = {{"symbol", t.symbol}};
+    try {
+      const FixedPointFrame frame = limit_frame(a, a.initial, t.symbol, dimension, inside);
+      f["point_mm"] = as_list(space_point(c, frame.point));
+      f["smooth"] = frame.smooth;
+      if (!frame.smooth) {
+        f["reason"] = frame.reason;
+      } else {
+        nlohmann::json tangents = nlohmann::json::array();
+        std::vector<Eigen::Vector3d> directions;
+        for (const Eigen::VectorXd& d : frame.directions) {
+          directions.push_back(space_direction(c, frame.point, d));
+          tangents.push_back(as_list(directions.back()));
+        }
+        f["tangents"] = tangents;
+        f["rates"] = frame.rates;
+        if (dimension == 2) {
+          const Eigen::Vector3d n = directions[0].cross(directions[1]);
+          f["normal"] = as_list(n.norm() > 0 ? Eigen::Vector3d(n / n.norm()) : n);
+        }
+      }
+    } catch (const InvalidInput& e) {
+      f["smooth"] = false;
+      f["reason"] = e.what();
+    }
+    frames.push_back(f);
+  }
+  return frames;
+}
+
 nlohmann::json system_json(const Cifs& c) {
   const Automaton& a = c.automaton;
   auto matrix = [](const Eigen::MatrixXd& m) {
@@ -336,7 +396,8 @@ nlohmann::json system_json(const Cifs& c) {
           {"rational", c.rational},
           {"states", states},
           {"transitions", transitions},
-          {"control_points_mm", points}};
+          {"control_points_mm", points},
+          {"limit_frames", initial_frames_json(c)}};
 }
 
 }  // namespace cifs

@@ -29,5 +29,11 @@ Cifs load_system(const std::string& name_or_file);
 // stationary flags and primitive vertices; transitions with matrices; control points).
 nlohmann::json system_json(const Cifs& cifs);
 
+// Per symbol of the initial state, the limit point of symbol^ω in mm and, where the attractor is
+// smooth there (cifs/automaton.h, FixedPointFrame), its unit tangents (into the primitive) and for
+// surfaces the unit normal (first tangent x second); otherwise the reason. The primitives must be
+// complete (complete_primitives()).
+nlohmann::json initial_frames_json(const Cifs& cifs);
+
 }  // namespace cifs
 }  // namespace lacuna
