@@ -85,52 +85,12 @@ int run_bench(int argc, char** argv) {
     auto t0 = std::chrono::steady_clock::now();
     const fill::FillResult2 r = fill::fill_region(fill::rectangle_region({0, 0}, {side, side}), fill::circle_motif(), f);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    // Over eps = 100/32 .. 100/512 mm.
+    const fill::UncoveredBoxCount boxes = fill::uncovered_box_count(r.motifs, side, 5, 9);
     nlohmann::json counts = nlohmann::json::array();
-    std::vector<double> xs, ys;
-    for (int k = 3; k <= 9; ++k) {
-      const int n = 1 << k;
-      const double eps = side / n;
-      std::vector<std::vector<uint32_t>> bins(size_t(n) * size_t(n));
-      for (uint32_t i = 0; i < r.motifs.size(); ++i) {
-        const fill::Placement2& p = r.motifs[i];
-        const double radius = std::sqrt(p.area_mm2 / 3.14159265358979323846);
-        const int x0 = std::max(0, int((p.center_mm.x - radius) / eps)), x1 = std::min(n - 1, int((p.center_mm.x + radius) / eps));
-        const int y0 = std::max(0, int((p.center_mm.y - radius) / eps)), y1 = std::min(n - 1, int((p.center_mm.y + radius) / eps));
-        for (int y = y0; y <= y1; ++y)
-          for (int x = x0; x <= x1; ++x) bins[size_t(y) * size_t(n) + size_t(x)].push_back(i);
-      }
-      uint64_t uncovered = 0;
-      for (int y = 0; y < n; ++y)
-        for (int x = 0; x < n; ++x) {
-          bool covered = false;
-          for (uint32_t i : bins[size_t(y) * size_t(n) + size_t(x)]) {
-            const fill::Placement2& p = r.motifs[i];
-            const double r2 = p.area_mm2 / 3.14159265358979323846;
-            bool all = true;
-            for (int q = 0; q < 4 && all; ++q) {
-              const double dx = (x + (q & 1)) * eps - p.center_mm.x, dy = (y + (q >> 1)) * eps - p.center_mm.y;
-              all = dx * dx + dy * dy <= r2;
-            }
-            if (all) {
-              covered = true;
-              break;
-            }
-          }
-          uncovered += !covered;
-        }
-      counts.push_back({{"eps_mm", eps}, {"uncovered_boxes", uncovered}});
-      if (k >= 5) {
-        xs.push_back(std::log(1 / eps));
-        ys.push_back(std::log(double(uncovered)));
-      }
-    }
-    // Least-squares slope over eps = 100/32 .. 100/512 mm.
-    double mx = 0, my = 0;
-    for (size_t i = 0; i < xs.size(); ++i) mx += xs[i] / xs.size(), my += ys[i] / xs.size();
-    double sxy = 0, sxx = 0;
-    for (size_t i = 0; i < xs.size(); ++i) sxy += (xs[i] - mx) * (ys[i] - my), sxx += (xs[i] - mx) * (xs[i] - mx);
+    for (size_t i = 0; i < boxes.eps_mm.size(); ++i) counts.push_back({{"eps_mm", boxes.eps_mm[i]}, {"uncovered_boxes", boxes.boxes[i]}});
     result["box_counting"] = {{"circles", r.motifs.size()}, {"c", f.c}, {"expected_dimension", 2 / f.c},
-                              {"measured_dimension", sxy / sxx}, {"fill_seconds", seconds},
+                              {"measured_dimension", boxes.dimension}, {"fill_seconds", seconds},
                               {"fill_fraction", r.fill_fraction}, {"stop_reason", r.stop_reason}, {"counts", counts}};
   }
   result["peak_memory_bytes"] = peak_memory_bytes();

@@ -553,5 +553,57 @@ SignedDistance3 sphere_region_distance(const Vec3d& center_mm, double radius_mm)
   return [center_mm, radius_mm](const Vec3d& p) { return norm(p - center_mm) - radius_mm; };
 }
 
+UncoveredBoxCount uncovered_box_count(const std::vector<Placement2>& circles, double side, int first, int last) {
+  if (first < 0 || last < first + 1 || last > 14)
+    throw InvalidInput("uncovered_box_count: expected 0 <= first < last <= 14 box levels");
+  constexpr double kPi = 3.14159265358979323846;
+  UncoveredBoxCount out;
+  for (int k = first; k <= last; ++k) {
+    const int n = 1 << k;
+    const double eps = side / n;
+    std::vector<std::vector<uint32_t>> bins(size_t(n) * size_t(n));
+    for (uint32_t i = 0; i < circles.size(); ++i) {
+      const Placement2& p = circles[i];
+      const double radius = std::sqrt(p.area_mm2 / kPi);
+      const int x0 = std::max(0, int((p.center_mm.x - radius) / eps)), x1 = std::min(n - 1, int((p.center_mm.x + radius) / eps));
+      const int y0 = std::max(0, int((p.center_mm.y - radius) / eps)), y1 = std::min(n - 1, int((p.center_mm.y + radius) / eps));
+      for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x) bins[size_t(y) * size_t(n) + size_t(x)].push_back(i);
+    }
+    uint64_t uncovered = 0;
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x) {
+        bool covered = false;
+        for (uint32_t i : bins[size_t(y) * size_t(n) + size_t(x)]) {
+          const Placement2& p = circles[i];
+          const double r2 = p.area_mm2 / kPi;
+          bool all = true;
+          for (int q = 0; q < 4 && all; ++q) {
+            const double dx = (x + (q & 1)) * eps - p.center_mm.x, dy = (y + (q >> 1)) * eps - p.center_mm.y;
+            all = dx * dx + dy * dy <= r2;
+          }
+          if (all) {
+            covered = true;
+            break;
+          }
+        }
+        uncovered += !covered;
+      }
+    out.eps_mm.push_back(eps);
+    out.boxes.push_back(uncovered);
+  }
+  double mx = 0, my = 0;
+  const double m = double(out.eps_mm.size());
+  for (size_t i = 0; i < out.eps_mm.size(); ++i) mx += std::log(1 / out.eps_mm[i]) / m, my += std::log(double(out.boxes[i])) / m;
+  double sxy = 0, sxx = 0;
+  for (size_t i = 0; i < out.eps_mm.size(); ++i) {
+    const double x = std::log(1 / out.eps_mm[i]) - mx, y = std::log(double(out.boxes[i])) - my;
+    sxy += x * y;
+    sxx += x * x;
+  }
+  out.dimension = sxy / sxx;
+  return out;
+}
+
 }  // namespace fill
 }  // namespace lacuna

@@ -143,5 +143,16 @@ SignedDistance3 box_region_distance(const Box3& box);
 // The exact signed distance of a ball. Throws InvalidInput unless radius_mm > 0.
 SignedDistance3 sphere_region_distance(const Vec3d& center_mm, double radius_mm);
 
+// Box counting of what circles leave uncovered in the square [0, side]^2: for eps = side / 2^k,
+// k = first .. last, the boxes of side eps not inside one circle (a box lies in a circle when its
+// four corners do); the dimension is the least-squares slope of log N against log(1 / eps) (2 / c
+// by the area law). `circles` are placements of the circle motif (radius sqrt(area / pi)).
+struct UncoveredBoxCount {
+  std::vector<double> eps_mm;
+  std::vector<uint64_t> boxes;
+  double dimension = 0;
+};
+UncoveredBoxCount uncovered_box_count(const std::vector<Placement2>& circles, double side_mm, int first, int last);
+
 }  // namespace fill
 }  // namespace lacuna
