@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "bcifs/realize.h"
+#include "bcifs/topology.h"
 #include "fill/wallpaper.h"
 
 namespace lacuna {
@@ -44,8 +45,11 @@ std::vector<InputFigure> input_figures(const BuiltInputs& inputs) {
     const BuiltInput& input = inputs.inputs[i];
     if (input.plate) {
       const int level = std::min(input.plate->options.level, kMaxGeometryLevel);
+      PlateMeasures measures = measure_plate(*input.plate, 0, level);
       // The counts to level 10 at least (they need no geometry), so R_i nears its limit.
-      const PlateImages images = plate_images(measure_plate(*input.plate, 0, std::max(level, 10)));
+      for (size_t f = 0; f < measures.faces.size(); ++f)
+        measures.faces[f] = bcifs::lacunarity(input.plate->rules, input.plate->rules.roots[f], std::max(level, 10));
+      const PlateImages images = plate_images(measures);
       const std::string levels = "levels 0 to " + std::to_string(level) + ", R_i to " + std::to_string(std::max(level, 10));
       figures.push_back({name + ": density at level " + std::to_string(level) + " (windows of 31 of 1024 pixels)",
                          "image/png", as_string(images.density_png)});
