@@ -173,7 +173,16 @@ Eigen::VectorXd fixed_point(const Eigen::MatrixXd& m) {
   return x;
 }
 
-Eigen::VectorXd limit_point(const Automaton& a, int state, int symbol) {
+namespace {
+
+// symbol^omega from `state`: the matrices of the way to the loop (their product), the loop's
+// product, and the state the loop starts at. Throws InvalidInput if the symbol is undefined on the way.
+struct SymbolLoop {
+  Eigen::MatrixXd prefix, loop;
+  int loop_state = 0;
+};
+
+SymbolLoop follow_symbol(const Automaton& a, int state, int symbol) {
   std::vector<int> path{state};
   std::vector<const Transition*> steps;
   std::map<int, size_t> seen{{state, 0}};
@@ -185,17 +194,25 @@ Eigen::VectorXd limit_point(const Automaton& a, int state, int symbol) {
     steps.push_back(t);
     auto [it, fresh] = seen.emplace(t->target, path.size());
     path.push_back(t->target);
-    if (!fresh) {
-      // Loop: steps[it->second .. end) returns to path[it->second].
-      const size_t loop_start = it->second;
-      const int k = a.states[size_t(path[loop_start])].control_points;
-      Eigen::MatrixXd loop = Eigen::MatrixXd::Identity(k, k);
-      for (size_t s = loop_start; s < steps.size(); ++s) loop = loop * steps[s]->matrix;
-      Eigen::VectorXd x = fixed_point(loop);
-      for (size_t s = loop_start; s-- > 0;) x = steps[s]->matrix * x;
-      return x;
-    }
+    if (fresh) continue;
+    // Loop: steps[it->second .. end) returns to path[it->second].
+    const size_t loop_start = it->second;
+    SymbolLoop out;
+    out.loop_state = path[loop_start];
+    const int k = a.states[size_t(out.loop_state)].control_points, k0 = a.states[size_t(state)].control_points;
+    out.loop = Eigen::MatrixXd::Identity(k, k);
+    out.prefix = Eigen::MatrixXd::Identity(k0, k0);
+    for (size_t s = loop_start; s < steps.size(); ++s) out.loop = out.loop * steps[s]->matrix;
+    for (size_t s = 0; s < loop_start; ++s) out.prefix = out.prefix * steps[s]->matrix;
+    return out;
   }
+}
+
+}  // namespace
+
+Eigen::VectorXd limit_point(const Automaton& a, int state, int symbol) {
+  const SymbolLoop way = follow_symbol(a, state, symbol);
+  return way.prefix * fixed_point(way.loop);
 }
 
 FixedPointFrame fixed_point_frame(const Eigen::MatrixXd& m, int dimension, const Eigen::VectorXd& toward) {
@@ -250,42 +267,21 @@ FixedPointFrame fixed_point_frame(const Eigen::MatrixXd& m, int dimension, const
 }
 
 FixedPointFrame limit_frame(const Automaton& a, int state, int symbol, int dimension, const Eigen::VectorXd& toward) {
-  std::vector<int> path{state};
-  std::vector<const Transition*> steps;
-  std::map<int, size_t> seen{{state, 0}};
-  for (;;) {
-    const Transition* t = find_transition(a, path.back(), symbol);
-    if (!t)
-      throw InvalidInput(state_label(a, path.back()) + " has no transition on symbol " + std::to_string(symbol) +
-                         " to follow to its limit point");
-    steps.push_back(t);
-    auto [it, fresh] = seen.emplace(t->target, path.size());
-    path.push_back(t->target);
-    if (fresh) continue;
-    const size_t loop_start = it->second;
-    const int k = a.states[size_t(path[loop_start])].control_points;
-    Eigen::MatrixXd loop = Eigen::MatrixXd::Identity(k, k), prefix = Eigen::MatrixXd::Identity(a.states[size_t(state)].control_points, a.states[size_t(state)].control_points);
-    for (size_t s = loop_start; s < steps.size(); ++s) loop = loop * steps[s]->matrix;
-    for (size_t s = 0; s < loop_start; ++s) prefix = prefix * steps[s]->matrix;
-    // `toward` seen from the loop's state: its preimage is not needed, only an attractor point
-    // there on the same side; the loop's own other end (the limit of another symbol) serves.
-    Eigen::VectorXd toward_loop;
-    if (loop_start == 0) {
-      toward_loop = toward;
-    } else {
-      const Transition& other = a.transitions[size_t(path[loop_start])].front().symbol == symbol
-                                    ? a.transitions[size_t(path[loop_start])].back()
-                                    : a.transitions[size_t(path[loop_start])].front();
-      toward_loop = limit_point(a, path[loop_start], other.symbol);
-    }
-    FixedPointFrame frame = fixed_point_frame(loop, dimension, toward_loop);
-    frame.point = prefix * frame.point;
-    for (Eigen::VectorXd& d : frame.directions) {
-      d = prefix * d;
-      d /= d.norm();
-    }
-    return frame;
+  const SymbolLoop way = follow_symbol(a, state, symbol);
+  // `toward` seen from the loop's state: its preimage is not needed, only an attractor point there on
+  // the same side; the loop's own other end (the limit of another symbol) serves.
+  Eigen::VectorXd toward_loop = toward;
+  if (way.loop_state != state) {
+    const std::vector<Transition>& out = a.transitions[size_t(way.loop_state)];
+    toward_loop = limit_point(a, way.loop_state, (out.front().symbol == symbol ? out.back() : out.front()).symbol);
   }
+  FixedPointFrame frame = fixed_point_frame(way.loop, dimension, toward_loop);
+  frame.point = way.prefix * frame.point;
+  for (Eigen::VectorXd& d : frame.directions) {
+    d = way.prefix * d;
+    d /= d.norm();
+  }
+  return frame;
 }
 
 void complete_primitives(Automaton& a) {

@@ -18,6 +18,11 @@ from conftest import BINARY, SOURCE_DIR
 PIL = pytest.importorskip("PIL.Image")
 
 
+def run_recipe(recipe, out):
+    done = subprocess.run([BINARY, "run", str(recipe), "-o", str(out), "--quiet"], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+
+
 def slice_json(*args):
     done = subprocess.run([BINARY, "slice", *map(str, args), "--json"], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
@@ -28,9 +33,7 @@ def test_png_layers_match_prusaslicer(tmp_path):
     if not shutil.which("prusa-slicer"):
         pytest.skip("prusa-slicer is not installed (scripts/setup.sh --test installs it)")
     recipe = SOURCE_DIR / "samples" / "hollow_sphere.json"
-    done = subprocess.run([BINARY, "run", str(recipe), "-o", str(tmp_path / "run"), "--quiet"],
-                          capture_output=True, text=True)
-    assert done.returncode == 0, done.stderr
+    run_recipe(recipe, tmp_path / "run")
     report = slice_json(recipe, "-o", tmp_path / "layers.zip", "--layer-mm", 0.2, "--pixel-mm", 0.05)
     archive = zipfile.ZipFile(tmp_path / "layers.zip")
     manifest = json.loads(archive.read("manifest.json"))
@@ -102,9 +105,7 @@ def test_sl1_archive_matches_prusaslicer(tmp_path):
     if not shutil.which("prusa-slicer"):
         pytest.skip("prusa-slicer is not installed (scripts/setup.sh --test installs it)")
     recipe = SOURCE_DIR / "samples" / "hollow_sphere.json"
-    done = subprocess.run([BINARY, "run", str(recipe), "-o", str(tmp_path / "run"), "--quiet"],
-                          capture_output=True, text=True)
-    assert done.returncode == 0, done.stderr
+    run_recipe(recipe, tmp_path / "run")
     report = slice_json(recipe, "-o", tmp_path / "ours.sl1", "--layer-mm", 0.2)
     done = subprocess.run(["prusa-slicer", "--export-sla", "--no-supports-enable", "--no-pad-enable",
                            "--layer-height", "0.2", "--initial-layer-height", "0.2",
