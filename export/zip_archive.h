@@ -12,9 +12,14 @@ struct ZipEntry {
   std::string name;
   std::string_view bytes;  // the caller keeps them alive until the archive is made
   bool deflate = true;  // false: stored (already compressed data, such as PNG)
+  std::string file;     // when set, the entry's bytes are this file's (read as the archive is written);
+                        // the entry takes the file's mode, which in-memory entries have as 0666
 };
 
 // The archive's bytes; `where` names it in messages (IoError, ResourceLimit).
 std::string zip_archive(const std::vector<ZipEntry>& entries, const std::string& where);
+
+// The same archive written straight to `path`, never whole in memory.
+void write_zip_archive(const std::vector<ZipEntry>& entries, const std::string& path, const std::string& where);
 
 }  // namespace lacuna

@@ -27,7 +27,8 @@ packages=(build-essential cmake ninja-build ccache pkg-config
           libopenvdb-dev libboost-iostreams-dev libcgal-dev libgmp-dev libmpfr-dev libtet1.5-dev
           libdraco-dev lib3mf-dev libzip-dev zlib1g-dev libeigen3-dev libtbb-dev
           nlohmann-json3-dev libcli11-dev libgtest-dev
-          python3-dev pybind11-dev python3-numpy)
+          python3-dev pybind11-dev python3-numpy
+          libopenmpi-dev openmpi-bin)  # optional for building: `lacuna slice` over MPI ranks
 if [ "$mode" = test ]; then
   # Real downstream clients the tests run the outputs through.
   packages+=(prusa-slicer admesh gmsh calculix-ccx draco python3-pytest python3-meshio clang libclang-rt-14-dev

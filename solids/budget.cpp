@@ -14,6 +14,10 @@ namespace {
 constexpr double kTrianglesPerActiveVoxel = 1.6;
 constexpr double kGridBytesPerActiveVoxel = 12.0;
 constexpr double kMeshBytesPerTriangle = 180.0;
+// An offset's surface: the triangle mesh (12 bytes of corners, half a 24-byte vertex per triangle)
+// and the extraction's crossing maps; its distance band is counted as a wider level set. Checked
+// against the peak memory of bench/infill_60mm.json (README, "Streaming").
+constexpr double kSurfaceBytesPerTriangle = 72.0;
 constexpr double kPairBytes = 16.0;  // one (leaf, primitive) pair while rasterizing
 
 uint64_t saturate(double v) { return v >= 1.8e19 ? uint64_t(1.8e19) : uint64_t(std::max(v, 0.0)); }
@@ -41,6 +45,7 @@ MemoryEstimate estimate_from_voxels(uint64_t active_voxels, const VolumeOptions&
   e.triangles = saturate(double(active_voxels) * kTrianglesPerActiveVoxel);
   e.grid_bytes = saturate(double(active_voxels) * kGridBytesPerActiveVoxel);
   e.mesh_bytes = saturate(double(e.triangles) * kMeshBytesPerTriangle);
+  e.surface_bytes = saturate(double(e.triangles) * kSurfaceBytesPerTriangle);
   return e;
 }
 

@@ -16,6 +16,7 @@ struct MemoryEstimate {
   uint64_t triangles = 0;       // triangles of the extracted surface
   uint64_t grid_bytes = 0;      // level set plus rasterization work space
   uint64_t mesh_bytes = 0;      // extracting, writing, re-reading and checking the surface
+  uint64_t surface_bytes = 0;   // the surface alone, extracted to be distanced again (offsets, shells, skins)
 };
 
 // Narrow-band voxels a surface of this area needs, capped by the voxels of the box it lies in

@@ -375,6 +375,8 @@ size_t primitive_count(const GeometrySet& set) {
 struct PrimitiveRasterizer::Impl {
   VolumeOptions options;
   openvdb::FloatGrid::Ptr grid;
+  bool clipped = false;
+  double clip_lo = 0, clip_hi = 0;  // mm
 };
 
 PrimitiveRasterizer::PrimitiveRasterizer(const VolumeOptions& options) : impl_(std::make_unique<Impl>()) {
@@ -384,6 +386,15 @@ PrimitiveRasterizer::PrimitiveRasterizer(const VolumeOptions& options) : impl_(s
 
 PrimitiveRasterizer::~PrimitiveRasterizer() = default;
 
+void PrimitiveRasterizer::clip_z(double lo_mm, double hi_mm) {
+  const double band = impl_->options.voxel_size_mm * impl_->options.half_band_voxels;
+  if (!(std::isfinite(lo_mm) && std::isfinite(hi_mm) && hi_mm - lo_mm > 2 * band))
+    throw InvalidInput("a slab must be finite and more than two bands high");
+  impl_->clipped = true;
+  impl_->clip_lo = lo_mm;
+  impl_->clip_hi = hi_mm;
+}
+
 void PrimitiveRasterizer::add(const GeometrySet& batch) {
   const Grid g{impl_->options.voxel_size_mm, impl_->options.voxel_size_mm * impl_->options.half_band_voxels};
   const float band = static_cast<float>(g.band);
@@ -392,6 +403,17 @@ void PrimitiveRasterizer::add(const GeometrySet& batch) {
   const Plane* planes = flat.planes.data();
   if (prims.empty()) return;
   Progress progress("rasterize", prims.size() * 2);
+
+  // A slab: leaves beyond its band are never made; the slab's own distance, max(lo - z, z - hi),
+  // bounds every value from below (an intersection), so its faces get a band of their own.
+  const bool clipped = impl_->clipped;
+  const double clip_lo = impl_->clip_lo, clip_hi = impl_->clip_hi;
+  const int64_t clip_leaf_lo = clipped ? floor_div8(int64_t(std::ceil((clip_lo - g.band) / g.h))) : 0;
+  const int64_t clip_leaf_hi = clipped ? floor_div8(int64_t(std::floor((clip_hi + g.band) / g.h))) + 1 : 0;
+  auto slab_distance = [&](int z) { return static_cast<float>(std::max(clip_lo - z * g.h, z * g.h - clip_hi)); };
+  auto near_slab_face = [&](const openvdb::Coord& origin) {
+    return clipped && (slab_distance(origin[2]) > -band || slab_distance(origin[2] + 7) > -band);
+  };
 
   // 1. Which leaves each primitive's band reaches, sorted so every leaf is computed once from a
   // list in a fixed order (the result does not depend on the number of threads).
@@ -409,6 +431,11 @@ void PrimitiveRasterizer::add(const GeometrySet& batch) {
           throw ResourceLimit("the part spans more voxels than a grid can address; use a larger voxel size");
         lo[k] = floor_div8(int64_t(vlo));
         hi[k] = floor_div8(int64_t(vhi)) + 1;
+      }
+      if (clipped) {
+        lo[2] = std::max(lo[2], clip_leaf_lo);
+        hi[2] = std::min(hi[2], clip_leaf_hi);
+        if (lo[2] >= hi[2]) continue;
       }
       collect_pairs(q, planes, uint32_t(i), lo, hi, g, out);
     }
@@ -440,13 +467,14 @@ void PrimitiveRasterizer::add(const GeometrySet& batch) {
       const size_t begin = starts[li], end = starts[li + 1];
       bool inside = false;
       for (size_t k = begin; k < end && !inside; ++k) inside = pairs[k].interior != 0;
-      if (inside) {
+      const openvdb::Coord origin = unpack_leaf_origin(pairs[begin].leaf);
+      const bool at_face = near_slab_face(origin);
+      if (inside && !at_face) {
         interior[li] = 1;
         continue;
       }
-      const openvdb::Coord origin = unpack_leaf_origin(pairs[begin].leaf);
-      std::fill(values, values + 512, band);
-      for (size_t k = begin; k < end; ++k) {
+      std::fill(values, values + 512, inside ? -band : band);
+      for (size_t k = begin; k < end && !inside; ++k) {
         const Prim& q = prims[pairs[k].prim];
         int lo[3], hi[3];
         for (int a = 0; a < 3; ++a) {
@@ -464,6 +492,8 @@ void PrimitiveRasterizer::add(const GeometrySet& batch) {
           }
         }
       }
+      if (at_face)
+        for (int n = 0; n < 512; ++n) values[n] = std::max(values[n], slab_distance(origin[2] + (n & 7)));
       bool any_active = false, all_negative = true;
       for (float v : values) {
         if (std::fabs(v) < band) any_active = true;

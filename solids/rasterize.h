@@ -24,6 +24,11 @@ class PrimitiveRasterizer {
   PrimitiveRasterizer(const PrimitiveRasterizer&) = delete;
   PrimitiveRasterizer& operator=(const PrimitiveRasterizer&) = delete;
 
+  // Keeps only the slab lo_mm <= z <= hi_mm of what is added (before the first add): the level set
+  // becomes that of the pieces' union intersected with the slab, max(d, lo - z, z - hi), and no leaf
+  // beyond the slab's band is made. Values at least a band inside the slab equal the unclipped ones
+  // bit for bit. hi_mm - lo_mm must exceed two bands.
+  void clip_z(double lo_mm, double hi_mm);
   // Adds the batch's analytic pieces (tubes, spheres, shapes, surfaces, cells); others ignored.
   void add(const GeometrySet& batch);
   // The level set of everything added; the rasterizer starts over empty.

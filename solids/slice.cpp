@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "solids/vdb_internal.h"
 
@@ -32,6 +33,10 @@ std::vector<float> sample_layer(const Volume& volume, double z_mm, const LayerGr
 }
 
 Box3 solid_box(const Volume& volume) {
+  return solid_box(volume, -std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity());
+}
+
+Box3 solid_box(const Volume& volume, double z_lo_mm, double z_hi_mm) {
   if (volume.empty()) return Box3{};
   const openvdb::FloatGrid& grid = *volume.impl().grid;
   const double h = volume.voxel_size_mm();
@@ -46,6 +51,7 @@ Box3 solid_box(const Volume& volume) {
             if (!(d < 0)) continue;
             const openvdb::Coord c = v.getCoord();
             const Vec3d centre{c.x() * h, c.y() * h, c.z() * h};
+            if (!(centre.z >= z_lo_mm && centre.z <= z_hi_mm)) continue;
             const double r = -double(d);
             box.expand(centre - Vec3d{r, r, r});
             box.expand(centre + Vec3d{r, r, r});

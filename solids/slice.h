@@ -16,7 +16,9 @@ std::vector<float> sample_layer(const Volume& volume, double z_mm, const LayerGr
 
 // The box of the solid (mm): the union of the balls the inside voxels' distances guarantee to be
 // solid, so exact where the surface is flat or convex and within the interpolation's error (a
-// small fraction of a voxel) elsewhere. Empty for an empty volume.
+// small fraction of a voxel) elsewhere. Empty for an empty volume. With a range, only the voxels
+// whose centres lie in z_lo_mm <= z <= z_hi_mm count (a slab of a streamed run).
 Box3 solid_box(const Volume& volume);
+Box3 solid_box(const Volume& volume, double z_lo_mm, double z_hi_mm);
 
 }  // namespace lacuna

@@ -208,9 +208,36 @@ void validate(const GeometrySet& set) {
   }
 }
 
-Volume voxelize(const GeometrySet& set, const VolumeOptions& options) {
+Volume clip_to_slab(const Volume& volume, const ZSlab& slab) {
+  if (volume.empty()) return volume;
+  // The slab as a box reaching a band beyond the volume's sides, rasterized under the same clip so
+  // that its faces carry the same values as a clipped rasterization.
+  const Box3 box = volume.bounding_box();
+  const double reach = 2 * volume.band_mm() + volume.voxel_size_mm();
+  Shape s;
+  s.kind = Shape::Kind::kBox;
+  s.center_mm = {0.5 * (box.min.x + box.max.x), 0.5 * (box.min.y + box.max.y), 0.5 * (slab.lo_mm + slab.hi_mm)};
+  s.half_size_mm = {0.5 * (box.max.x - box.min.x) + reach, 0.5 * (box.max.y - box.min.y) + reach,
+                    0.5 * (slab.hi_mm - slab.lo_mm) + reach};
+  GeometrySet set;
+  set.shapes.push_back(s);
+  PrimitiveRasterizer rasterizer(volume.options());
+  rasterizer.clip_z(slab.lo_mm, slab.hi_mm);
+  rasterizer.add(set);
+  return intersect(volume, rasterizer.finish());
+}
+
+Volume voxelize_meshes(const GeometrySet& set, const VolumeOptions& options) {
+  Volume result;
+  for (const TriMesh& m : set.solids) result = unite(result, mesh_to_volume(m, options));
+  for (const Region2& r : set.regions) result = unite(result, mesh_to_volume(extrude_region(r), options));
+  return result;
+}
+
+Volume voxelize(const GeometrySet& set, const VolumeOptions& options, const ZSlab* slab, const Volume* meshes) {
   validate(set);
   PrimitiveRasterizer rasterizer(options);
+  if (slab) rasterizer.clip_z(slab->lo_mm, slab->hi_mm);
   rasterizer.add(set);
   for (const GeometryStream& stream : set.streams)
     stream.emit([&](const GeometrySet& batch) {
@@ -218,9 +245,9 @@ Volume voxelize(const GeometrySet& set, const VolumeOptions& options) {
       rasterizer.add(batch);
     });
   Volume result = rasterizer.finish();
-  for (const TriMesh& m : set.solids) result = unite(result, mesh_to_volume(m, options));
-  for (const Region2& r : set.regions) result = unite(result, mesh_to_volume(extrude_region(r), options));
-  return result;
+  if (set.solids.empty() && set.regions.empty()) return result;
+  const Volume converted = meshes ? *meshes : voxelize_meshes(set, options);
+  return unite(result, slab ? clip_to_slab(converted, *slab) : converted);
 }
 
 }  // namespace lacuna

@@ -368,6 +368,104 @@ TEST(Slice, RefusesClearlyAndLeavesNothing) {
   EXPECT_NE(ok.out.find("20 layers of 0.2 mm"), std::string::npos) << ok.out;
 }
 
+// Every operation kind between the inputs, a converted region among them: what a slab must
+// evaluate with its halo to equal the whole run.
+std::string operations_recipe(const TempDir& dir) {
+  const fs::path path = dir / "ops.json";
+  write_file(path, R"({"lacuna_recipe": 1, "name": "ops", "voxel_size_mm": 0.1,
+    "inputs": {
+      "ball": {"type": "sphere", "center_mm": [0, 0, 0.3], "radius_mm": 3},
+      "bar": {"type": "box", "center_mm": [0, 0, 0], "size_mm": [8, 1.5, 1.44]},
+      "plate": {"type": "region", "loops_mm": [[[-4, -4], [4, -4], [4, 4], [-4, 4]], [[-1, -1], [-1, 1], [1, 1], [1, -1]]],
+                "height_mm": 1, "origin_mm": [0, 0, -2.6]},
+      "hole": {"type": "cylinder", "center_mm": [0, 0, 0], "axis": [1, 0, 0], "radius_mm": 0.6, "height_mm": 10},
+      "cap": {"type": "box", "min_mm": [-5, -5, -5], "max_mm": [5, 5, 2.2]}},
+    "operations": [
+      {"name": "joined", "op": "union", "of": ["ball", "bar", "plate"]},
+      {"name": "drilled", "op": "difference", "of": ["joined", "hole"]},
+      {"name": "cut", "op": "intersection", "of": ["drilled", "cap"]},
+      {"name": "grown", "op": "offset", "of": "cut", "distance_mm": 0.3},
+      {"name": "shrunk", "op": "offset", "of": "grown", "distance_mm": -0.5},
+      {"name": "walls", "op": "shell", "of": "shrunk", "thickness_mm": 0.4}],
+    "outputs": [{"of": "walls", "file": "walls.stl"}]})");
+  return path.string();
+}
+
+TEST(Slice, SlabBySlabGivesTheWholeRunsBytes) {
+  TempDir dir;
+  struct Case {
+    std::string recipe, object;
+    double voxel_mm, slab_mm;
+  };
+  const std::string source = LACUNA_SOURCE_DIR;
+  const Case cases[] = {
+      {operations_recipe(dir), "walls", 0, 1.6},
+      {operations_recipe(dir), "cut", 0, 0.8},
+      // An imported hull filled with a lattice: a mesh converted once and clipped per slab, an infill's skin.
+      {source + "/samples/egg_infill.json", "part", 0.3, 2.4},
+      // A streamed CIFS input (cells), no operation: the halo is a band.
+      {source + "/samples/menger_sponge.json", "sponge", 0, 2.0},
+  };
+  for (size_t i = 0; i < std::size(cases); ++i) {
+    const Case& c = cases[i];
+    SCOPED_TRACE(c.recipe + " " + c.object);
+    {
+      const char* name = i % 2 == 0 ? "layers.zip" : "layers.cli";  // images and contours
+      SliceOptions options;
+      options.object = c.object;
+      options.run.voxel_size_mm = c.voxel_mm;
+      const SliceReport whole = slice_recipe(c.recipe, (dir / ("whole-" + std::string(name))).string(), options);
+      options.slab_mm = c.slab_mm;
+      const SliceReport slabs = slice_recipe(c.recipe, (dir / ("slabs-" + std::string(name))).string(), options);
+      ASSERT_TRUE(whole.valid && slabs.valid);
+      EXPECT_EQ(whole.slabs, 1u);
+      EXPECT_GE(slabs.slabs, 4u);
+      EXPECT_GT(slabs.halo_mm, 0);
+      EXPECT_GT(whole.layers.size(), 20u);
+      EXPECT_EQ(test::read_file(dir / ("whole-" + std::string(name))), test::read_file(dir / ("slabs-" + std::string(name))));
+    }
+  }
+}
+
+TEST(Slice, TheBudgetPicksTheSlabsAndNothingIsLeftBehind) {
+  TempDir dir;
+  const std::string recipe = std::string(LACUNA_SOURCE_DIR) + "/samples/menger_sponge.json";
+  SliceOptions options;
+  options.run.voxel_size_mm = 1.0 / 9;
+  const SliceReport whole = slice_recipe(recipe, (dir / "whole.zip").string(), options);
+  ASSERT_TRUE(whole.valid);
+  EXPECT_EQ(whole.slabs, 1u);
+  // A third of the whole part's estimate: the slabs are as high as fits, and no higher.
+  options.run.max_memory_bytes = whole.memory_estimate_bytes / 3;
+  const SliceReport slabs = slice_recipe(recipe, (dir / "slabs.zip").string(), options);
+  ASSERT_TRUE(slabs.valid);
+  EXPECT_GE(slabs.slabs, 3u);
+  EXPECT_LE(slabs.memory_estimate_bytes, options.run.max_memory_bytes);
+  EXPECT_EQ(test::read_file(dir / "whole.zip"), test::read_file(dir / "slabs.zip"));
+  // A PNG folder streams its images into place: the same images, no spooled file left.
+  const SliceReport folder = slice_recipe(recipe, (dir / "folder").string(), options);
+  ASSERT_TRUE(folder.valid);
+  size_t files = 0;
+  for (const auto& entry : fs::directory_iterator(dir / "folder")) {
+    const std::string name = entry.path().filename().string();
+    EXPECT_TRUE(name == "manifest.json" || name.rfind("layer_", 0) == 0) << name;
+    ++files;
+  }
+  EXPECT_EQ(files, folder.layers.size() + 1);
+  // Too small a budget for even one slab: refused before building, nothing on disk.
+  options.run.max_memory_bytes = 1000000;
+  try {
+    slice_recipe(recipe, (dir / "tiny.zip").string(), options);
+    ADD_FAILURE() << "expected a refusal";
+  } catch (const ResourceLimit& e) {
+    EXPECT_NE(std::string(e.what()).find("slabs of"), std::string::npos) << e.what();
+  }
+  for (const auto& entry : fs::directory_iterator(dir.path())) {
+    const std::string name = entry.path().filename().string();
+    EXPECT_TRUE(name == "whole.zip" || name == "slabs.zip" || name == "folder") << name;
+  }
+}
+
 TEST(Slice, RecipeOutputsAreTheSameLayersWithoutAMesh) {
   TempDir dir;
   write_file(dir / "r.json", R"({"lacuna_recipe": 1, "name": "r", "voxel_size_mm": 0.1,

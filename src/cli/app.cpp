@@ -21,6 +21,7 @@
 #include "cli/curve_commands.h"
 #include "cli/exit_codes.h"
 #include "cli/fill_commands.h"
+#include "cli/mpi_ranks.h"
 #include "cli/number_checks.h"
 #include "cli/terminal_progress.h"
 #include "cli/voronoi_commands.h"
@@ -193,7 +194,11 @@ struct SliceArgs {
 // `lacuna slice`: a recipe's object as layers (PNG stack, zipped or not, or a CLI file).
 int command_slice(SliceArgs args, const RunOptions& base, const CommonFlags& flags) {
   args.options.run = base;
+  // Under mpirun: one rank of a job; the first prints what the job did.
+  const std::unique_ptr<SliceRanks> ranks = mpi_ranks();
+  args.options.ranks = ranks.get();
   const SliceReport report = slice_recipe(args.recipe, args.output, args.options);
+  if (ranks && ranks->rank() != 0) return report.valid ? kExitOk : kExitCheckFailed;
   const nlohmann::json j = to_json(report);
   if (flags.json) std::cout << j.dump(2) << "\n";
   if (!report.valid) {
@@ -317,7 +322,8 @@ int run_app(int argc, char** argv) {
   CLI::App app{"Lacuna: volumetric solid modeling for additive manufacturing.\n"
                "Runs recipe files (JSON) into checked, printable STL, 3MF and Draco parts.\n"
                "Exit codes: 0 success, 2 bad usage or input, 3 resource limit, 4 failed validity check."};
-  app.set_version_flag("--version", "lacuna " LACUNA_VERSION);
+  app.set_version_flag("--version", std::string("lacuna " LACUNA_VERSION) +
+                                        (built_with_mpi() ? " (slice runs over MPI ranks)" : ""));
   app.require_subcommand(1);
 
   CommonFlags flags;
@@ -422,8 +428,14 @@ int run_app(int argc, char** argv) {
   slice->add_option("--object", slice_args.options.object, "The recipe's input or operation (default: its first output's)");
   slice->add_option("--voxel-size", run_options.voxel_size_mm, "Voxel size in mm, overriding the recipe's")
       ->check(number_in(kMinVoxelSizeMm, kMaxVoxelSizeMm));
-  slice->add_option("--max-memory", max_memory_gb, "Memory budget in GB (default: half of the machine's memory)")
+  slice->add_option("--max-memory", max_memory_gb,
+                    "Memory budget in GB (default: half of the machine's memory); a part whose level set does not\n"
+                    "fit is evaluated slab by slab, each as high as fits")
       ->check(number_in(0, 1e9, true));
+  slice->add_option("--slab-mm", slice_args.options.slab_mm,
+                    "Evaluate slab by slab, this high in mm (default: the whole part when it fits the budget;\n"
+                    "under mpirun -np K, at least K slabs, split over the ranks)")
+      ->check(non_negative_number());
   add_common(slice, flags);
   std::function<int()> cifs_command = add_cifs_commands(app);
   std::function<int()> curve_command = add_curve_commands(app);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <variant>
 
 #include "errors.h"
@@ -42,24 +43,48 @@ const RecipeOperation& operation_named(const Recipe& recipe, const std::string& 
   throw InternalError("no operation is named \"" + name + "\"");
 }
 
-// Memory for everything the plan builds, refused before any large allocation: every level set
-// it keeps (conservatively, all of them at once) plus the largest surface it meshes and checks.
-struct Estimate {
-  uint64_t grid_bytes = 0;
-  uint64_t mesh_bytes = 0;
-  uint64_t voxels = 0;
-  uint64_t triangles = 0;
-  uint64_t bytes() const { return grid_bytes + mesh_bytes; }
-};
 
-Estimate estimate(const Recipe& recipe, const Plan& plan, const BuiltInputs& inputs, const VolumeOptions& vopt) {
+// The share of a box's height inside the slab's reach (1 without a slab).
+double slab_share(const Box3& box, const ZSlab* slab, double band) {
+  if (!slab) return 1;
+  const double height = box.max.z - box.min.z;
+  const double lo = std::max(box.min.z, slab->lo_mm - band), hi = std::min(box.max.z, slab->hi_mm + band);
+  if (hi <= lo) return 0;
+  return height > 0 ? std::min(1.0, (hi - lo) / height) : 1.0;
+}
+
+// The box clipped to the slab's reach, and the slab's two faces across it (mm^2).
+Box3 in_slab(Box3 box, const ZSlab* slab, double band, double* faces_mm2) {
+  *faces_mm2 = 0;
+  if (!slab) return box;
+  box.min.z = std::max(box.min.z, slab->lo_mm - band);
+  box.max.z = std::min(box.max.z, slab->hi_mm + band);
+  if (box.max.z < box.min.z) box.max.z = box.min.z;
+  *faces_mm2 = 2 * (box.max.x - box.min.x) * (box.max.y - box.min.y);
+  return box;
+}
+
+// What voxelizing each planned input needs as a whole (the geometry's area bound and work space).
+std::map<std::string, MemoryEstimate> input_estimates(const Recipe& recipe, const Plan& plan, const BuiltInputs& inputs,
+                                                      const VolumeOptions& vopt) {
+  std::map<std::string, MemoryEstimate> out;
+  for (const std::string& name : plan.inputs)
+    out[name] = in_context(recipe.file + ": " + input_named(recipe, name).json_path,
+                           [&] { return estimate_voxelize(inputs.at(name).geometry, vopt); });
+  return out;
+}
+
+// Memory for everything the plan builds, refused before any large allocation.
+MemoryNeed estimate(const Recipe& recipe, const Plan& plan, const std::map<std::string, MemoryEstimate>& input_estimate,
+                  const VolumeOptions& vopt, const std::map<std::string, ObjectExtent>& extents, const ZSlab* slab) {
   struct Object {
     double area = 0;
     Box3 box;
     uint64_t voxels = 0;
   };
+  const double band = vopt.voxel_size_mm * vopt.half_band_voxels;
   std::map<std::string, Object> objects;
-  Estimate total;
+  MemoryNeed total;
   auto mesh_of = [&](uint64_t voxels, double simplify_mm = 0) {
     MemoryEstimate m = estimate_from_voxels(voxels, vopt);
     m.mesh_bytes = uint64_t(double(m.mesh_bytes) * compact_mesh_share(simplify_mm, vopt.voxel_size_mm));
@@ -69,24 +94,26 @@ Estimate estimate(const Recipe& recipe, const Plan& plan, const BuiltInputs& inp
     }
   };
   for (const std::string& name : plan.inputs) {
-    const GeometrySet& geometry = inputs.at(name).geometry;
-    MemoryEstimate e = in_context(recipe.file + ": " + input_named(recipe, name).json_path,
-                                  [&] { return estimate_voxelize(geometry, vopt); });
-    objects[name] = {e.surface_area_mm2, bounding_box(geometry), e.active_voxels};
-    total.grid_bytes += e.grid_bytes;
-    total.voxels += e.active_voxels;
+    const MemoryEstimate& e = input_estimate.at(name);
+    const Box3& whole = extents.at(name).box;
+    const double share = slab_share(whole, slab, band);
+    double faces = 0;
+    const Box3 box = in_slab(whole, slab, band, &faces);
+    const double area = e.surface_area_mm2 * share + faces;
+    objects[name] = {area, box, band_voxels(area, box, vopt)};
+    const uint64_t voxels = slab ? objects[name].voxels : e.active_voxels;
+    total.grid_bytes += slab ? estimate_from_voxels(voxels, vopt).grid_bytes : e.grid_bytes;
+    total.voxels += voxels;
   }
   for (const std::string& name : plan.operations) {
     const OperationSpec& op = operation_named(recipe, name).spec;
     const std::vector<std::string> of = operands(op);
     Object o;
     const Object& first = objects[of[0]];
-    o.box = first.box;
+    double faces = 0;
+    o.box = in_slab(extents.at(name).box, slab, band, &faces);
     const auto* csg = std::get_if<CsgOperation>(&op);
-    for (const std::string& operand : of) {
-      o.area += objects[operand].area;
-      if (csg && csg->kind == CsgOperation::Kind::kUnion) o.box.expand(objects[operand].box);
-    }
+    for (const std::string& operand : of) o.area += objects[operand].area;
     VolumeOptions work = vopt;
     if (!csg) {
       // Goes through the operand's surface mesh and a band as wide as the distance.
@@ -94,20 +121,17 @@ Estimate estimate(const Recipe& recipe, const Plan& plan, const BuiltInputs& inp
       const auto* shell = std::get_if<ShellOperation>(&op);
       double d = offset ? std::fabs(offset->distance_mm) : shell ? shell->thickness_mm : std::get<InfillOperation>(op).skin_mm;
       // Going inwards, nothing is deeper than half the box's smallest side.
-      const Vec3d size = first.box.size();
+      const Vec3d size = extents.at(of[0]).box.size();
       const double half_thickness = 0.5 * std::min({size.x, size.y, size.z});
       if (offset && offset->distance_mm < 0 && d >= half_thickness)
         throw InvalidInput(recipe.file + ": " + operation_named(recipe, name).json_path + ": an offset of " +
                            fixed(offset->distance_mm, 6) + " mm leaves nothing of \"" + of[0] + "\" (it is at most " +
                            fixed(2 * half_thickness, 6) + " mm thick)");
       if (!offset || offset->distance_mm < 0) d = std::min(d, half_thickness);
-      mesh_of(first.voxels);
+      total.mesh_bytes = std::max(total.mesh_bytes, estimate_from_voxels(first.voxels, vopt).surface_bytes);
       work.half_band_voxels += d / vopt.voxel_size_mm;
-      if (offset && offset->distance_mm > 0) {
-        o.box.min -= Vec3d{d, d, d};
-        o.box.max += Vec3d{d, d, d};
-      }
-      MemoryEstimate wide = estimate_from_voxels(band_voxels(o.area, o.box, work), work);
+      // The band as wide as the distance is around the first operand only (an infill's hull).
+      MemoryEstimate wide = estimate_from_voxels(band_voxels(first.area, o.box, work), work);
       total.grid_bytes += wide.grid_bytes;
     }
     o.voxels = band_voxels(o.area, o.box, vopt);
@@ -124,10 +148,69 @@ Estimate estimate(const Recipe& recipe, const Plan& plan, const BuiltInputs& inp
 
 }  // namespace
 
+std::map<std::string, ObjectExtent> object_extents(const Recipe& recipe, const Plan& plan, const BuiltInputs& inputs) {
+  const double h = recipe.voxel_size_mm, band = h * recipe.band_voxels;
+  std::map<std::string, ObjectExtent> extents;
+  // A rasterized input equals the whole run's a band inside the slab (its faces' band); a level set
+  // remade from a surface (offsets, shells, infills) needs its operand right out to the distance it
+  // reaches, a band, and the voxel cubes its triangles come from.
+  for (const std::string& name : plan.inputs) extents[name] = {bounding_box(inputs.at(name).geometry), band + h};
+  for (const std::string& name : plan.operations) {
+    const OperationSpec& op = operation_named(recipe, name).spec;
+    const std::vector<std::string> of = operands(op);
+    ObjectExtent e = extents.at(of[0]);
+    if (const auto* csg = std::get_if<CsgOperation>(&op)) {
+      for (size_t i = 1; i < of.size(); ++i) {
+        const ObjectExtent& next = extents.at(of[i]);
+        e.halo_mm = std::max(e.halo_mm, next.halo_mm);
+        if (csg->kind == CsgOperation::Kind::kUnion) e.box.expand(next.box);
+      }
+      if (csg->kind == CsgOperation::Kind::kIntersection)
+        for (size_t i = 1; i < of.size(); ++i)
+          for (int k = 0; k < 3; ++k) {
+            e.box.min[k] = std::max(e.box.min[k], extents.at(of[i]).box.min[k]);
+            e.box.max[k] = std::max(e.box.min[k], std::min(e.box.max[k], extents.at(of[i]).box.max[k]));
+          }
+    } else if (const auto* offset = std::get_if<OffsetOperation>(&op)) {
+      const double d = offset->distance_mm;
+      e.halo_mm += std::fabs(d) + band + 3 * h;
+      if (d > 0) {
+        e.box.min -= Vec3d{d, d, d};
+        e.box.max += Vec3d{d, d, d};
+      }
+    } else if (const auto* shell = std::get_if<ShellOperation>(&op)) {
+      e.halo_mm += shell->thickness_mm + band + 3 * h;
+    } else {
+      const auto& fill = std::get<InfillOperation>(op);
+      const ObjectExtent& hull = extents.at(fill.hull);
+      e = {hull.box, std::max(extents.at(fill.structure).halo_mm, hull.halo_mm + fill.skin_mm + band + 3 * h)};
+    }
+    extents[name] = e;
+  }
+  return extents;
+}
+
 Volume Evaluation::take(const std::string& name) {
   Volume v = volumes.at(name);
   if (--uses[name] == 0) volumes.erase(name);
   return v;
+}
+
+MemoryEstimator::MemoryEstimator(const Recipe& recipe, const Plan& plan, const BuiltInputs& inputs)
+    : recipe_(recipe),
+      plan_(plan),
+      extents_(object_extents(recipe, plan, inputs)),
+      inputs_(input_estimates(recipe, plan, inputs, VolumeOptions{recipe.voxel_size_mm, recipe.band_voxels})) {}
+
+MemoryNeed MemoryEstimator::need(const ZSlab* slab) const {
+  return estimate(recipe_, plan_, inputs_, VolumeOptions{recipe_.voxel_size_mm, recipe_.band_voxels}, extents_, slab);
+}
+
+uint64_t MemoryEstimator::bytes(const std::vector<ZSlab>& slabs) const {
+  if (slabs.empty()) return need().bytes();
+  uint64_t most = 0;
+  for (const ZSlab& slab : slabs) most = std::max(most, need(&slab).bytes());
+  return most;
 }
 
 Evaluation evaluate(const Recipe& recipe, const Plan& plan, const BuiltInputs& inputs, const EvaluateOptions& options) {
@@ -155,7 +238,10 @@ Evaluation evaluate(const Recipe& recipe, const Plan& plan, const BuiltInputs& i
                         fixed(kMaxCoordinateInVoxels, 6) + " voxels of " + fixed(vopt.voxel_size_mm, 6) +
                         " mm; float32 output cannot keep such a fine surface exact. Move the part nearer the origin "
                         "or use a voxel size of at least " + fixed(reach / kMaxCoordinateInVoxels, 3) + " mm");
-  Estimate need = estimate(recipe, plan, inputs, vopt);
+  std::optional<MemoryEstimator> own;  // a plan's own, unless the caller made one
+  const MemoryEstimator& estimator = options.estimator ? *options.estimator : own.emplace(recipe, plan, inputs);
+  const MemoryNeed need = estimator.need(options.slab);
+  result.extents = estimator.extents();
   result.memory_estimate_bytes = need.bytes();
   if (need.bytes() > budget)
     throw ResourceLimit(detail::refusal(recipe.file + ": this recipe (about " + fixed(double(need.voxels), 3) +
@@ -169,7 +255,14 @@ Evaluation evaluate(const Recipe& recipe, const Plan& plan, const BuiltInputs& i
   for (const std::string& name : plan.inputs) {
     throw_if_cancelled(sink);
     result.volumes[name] = in_context(recipe.file + ": " + input_named(recipe, name).json_path,
-                                      [&] { return voxelize(inputs.at(name).geometry, vopt); });
+                                      [&] {
+                                        const GeometrySet& geometry = inputs.at(name).geometry;
+                                        if (!options.converted_meshes || (geometry.solids.empty() && geometry.regions.empty()))
+                                          return voxelize(geometry, vopt, options.slab);
+                                        auto [kept, made] = options.converted_meshes->try_emplace(name);
+                                        if (made) kept->second = voxelize_meshes(geometry, vopt);
+                                        return voxelize(geometry, vopt, options.slab, &kept->second);
+                                      });
   }
   timer.start("combine");
   for (const std::string& name : plan.operations) {
@@ -189,16 +282,16 @@ Evaluation evaluate(const Recipe& recipe, const Plan& plan, const BuiltInputs& i
       }
     } else if (const auto* offset = std::get_if<OffsetOperation>(&op.spec)) {
       v = result.take(offset->of);
-      detail::require_mesh_memory(v, budget, where, vopt);
+      detail::require_surface_memory(v, budget, where, vopt);
       v = lacuna::offset(v, offset->distance_mm);
     } else if (const auto* shell = std::get_if<ShellOperation>(&op.spec)) {
       v = result.take(shell->of);
-      detail::require_mesh_memory(v, budget, where, vopt);
+      detail::require_surface_memory(v, budget, where, vopt);
       v = lacuna::shell(v, shell->thickness_mm);
     } else {
       const auto& fill = std::get<InfillOperation>(op.spec);
       Volume hull = result.take(fill.hull), structure = result.take(fill.structure);
-      detail::require_mesh_memory(hull, budget, where, vopt);
+      detail::require_surface_memory(hull, budget, where, vopt);
       // Fused by a voxel unless told otherwise (and never through the whole skin).
       double fuse = fill.fuse_mm >= 0 ? fill.fuse_mm : std::min(vopt.voxel_size_mm, 0.5 * fill.skin_mm);
       v = in_context(where, [&] { return infill(hull, structure, fill.skin_mm, fuse); });

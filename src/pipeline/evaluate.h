@@ -12,7 +12,9 @@
 #include "pipeline/build_inputs.h"
 #include "pipeline/plan.h"
 #include "recipe/recipe.h"
+#include "solids/budget.h"
 #include "solids/volume.h"
+#include "solids/voxelize.h"
 #include "util/progress.h"
 
 namespace lacuna {
@@ -20,7 +22,24 @@ namespace lacuna {
 struct EvaluateOptions {
   uint64_t max_memory_bytes = 0;     // 0: half the memory available to the process
   ProgressSink* progress = nullptr;  // null: the sink current on this thread
+  // A streamed run's slab: the inputs are built only there (see voxelize()), the operations act on
+  // what that leaves, and the memory is estimated for the slab. Every object then equals the whole
+  // run's bit for bit at least its halo inside the slab (object_extents()).
+  const ZSlab* slab = nullptr;
+  // A streamed run's inputs' closed meshes, converted in the first slab and kept for the others.
+  std::map<std::string, Volume>* converted_meshes = nullptr;
+  // The plan's estimator, made once for every slab (null: made here).
+  const class MemoryEstimator* estimator = nullptr;
 };
+
+// Where an object can be, known before any voxel is made.
+struct ObjectExtent {
+  Box3 box;            // holds the solid: the inputs' geometry, grown by unions and outward offsets
+  double halo_mm = 0;  // evaluated in a slab, the object equals the whole run's this far inside it
+};
+
+// The extent of every object the plan builds (inputs and operations).
+std::map<std::string, ObjectExtent> object_extents(const Recipe& recipe, const Plan& plan, const BuiltInputs& inputs);
 
 // The level sets the outputs mesh, and what the run needs to report about them.
 struct Evaluation {
@@ -30,9 +49,36 @@ struct Evaluation {
   uint64_t memory_estimate_bytes = 0;
   uint64_t memory_budget_bytes = 0;
   std::vector<std::pair<std::string, double>> stage_seconds;  // timed so far; write_outputs adds its own after them
+  std::map<std::string, ObjectExtent> extents;    // every object's, known before evaluating
 
   // The object's level set for one of its reads; released here after its last.
   Volume take(const std::string& name);
+};
+
+// The memory evaluate() estimates for a plan, before building anything; what voxelizing each input
+// needs is worked out once (a streamed input is walked for it), so slabs of many heights can be tried.
+struct MemoryNeed {
+  uint64_t grid_bytes = 0;  // every level set the plan keeps (conservatively, all at once)
+  uint64_t mesh_bytes = 0;  // the largest surface it meshes and checks (or distances again)
+  uint64_t voxels = 0;
+  uint64_t triangles = 0;
+  uint64_t bytes() const { return grid_bytes + mesh_bytes; }
+};
+
+class MemoryEstimator {
+ public:
+  MemoryEstimator(const Recipe& recipe, const Plan& plan, const BuiltInputs& inputs);
+  // What evaluating the plan (in the slab, when given) needs.
+  MemoryNeed need(const ZSlab* slab = nullptr) const;
+  // The most any of the slabs needs, or the whole part when there are none.
+  uint64_t bytes(const std::vector<ZSlab>& slabs = {}) const;
+  const std::map<std::string, ObjectExtent>& extents() const { return extents_; }
+
+ private:
+  const Recipe& recipe_;
+  const Plan& plan_;
+  std::map<std::string, ObjectExtent> extents_;
+  std::map<std::string, MemoryEstimate> inputs_;
 };
 
 // Voxelizes the planned inputs and evaluates the planned operations. Throws ResourceLimit, before

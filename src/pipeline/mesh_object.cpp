@@ -28,8 +28,9 @@ uint64_t budget_of(uint64_t max_memory_bytes) {
   return max_memory_bytes ? max_memory_bytes : available_memory_bytes() / 2;
 }
 
-// The recipe with one output: the object, so that the plan builds what it needs and nothing else.
-Recipe with_only(const Recipe& recipe, const std::string& object) {
+}  // namespace
+
+Recipe recipe_for_object(const Recipe& recipe, const std::string& object) {
   Recipe only = recipe;
   std::vector<std::string> names;
   for (const RecipeInput& in : recipe.inputs) names.push_back(in.name);
@@ -49,6 +50,8 @@ Recipe with_only(const Recipe& recipe, const std::string& object) {
   return only;
 }
 
+namespace {
+
 Volume evaluate_only(const Recipe& only, const ObjectOptions& options) {
   const uint64_t budget = budget_of(options.max_memory_bytes);
   const BuiltInputs inputs = build_inputs(only, budget);
@@ -64,7 +67,7 @@ Volume evaluate_only(const Recipe& only, const ObjectOptions& options) {
 Volume evaluate_object(const Recipe& recipe, const std::string& object, const ObjectOptions& options) {
   ProgressSinkScope progress(options.progress ? options.progress : current_progress_sink());
   const auto threads = thread_limit(options.threads);
-  return evaluate_only(with_only(recipe, object), options);
+  return evaluate_only(recipe_for_object(recipe, object), options);
 }
 
 ObjectMesh mesh_volume(const Volume& volume, double simplify_mm, const std::string& what, uint64_t max_memory_bytes) {
@@ -99,7 +102,7 @@ ObjectMesh extract_object_surface(const Volume& volume, double simplify_mm) {
 ObjectMesh mesh_object(const Recipe& recipe, const std::string& object, const ObjectOptions& options) {
   ProgressSinkScope progress(options.progress ? options.progress : current_progress_sink());
   const auto threads = thread_limit(options.threads);
-  Recipe only = with_only(recipe, object);
+  Recipe only = recipe_for_object(recipe, object);
   if (options.simplify_mm >= 0) {
     only.simplify_mm = options.simplify_mm;
     only.outputs.front().simplify_mm.reset();

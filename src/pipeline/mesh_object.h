@@ -31,6 +31,10 @@ struct ObjectMesh {
   size_t subvoxel_specks_removed = 0;
 };
 
+// The recipe with one output, the object `object` (default: the first output's), so that a plan
+// builds what it needs and nothing else. Throws InvalidInput for an unknown object.
+Recipe recipe_for_object(const Recipe& recipe, const std::string& object);
+
 // The level set of the recipe's object `object` (default: the first output's), with only what it
 // needs built. Throws InvalidInput for an unknown object and whatever building and evaluating throw
 // (InvalidInput, IoError, ResourceLimit before allocating beyond the budget, Cancelled).

@@ -6,9 +6,12 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <memory>
+#include <mutex>
 #include <nlohmann/json.hpp>
+#include <limits>
 #include <optional>
 
 #include "errors.h"
@@ -16,7 +19,10 @@
 #include "export/output_files.h"
 #include "export/zip_archive.h"
 #include "pipeline/detail/memory.h"
+#include "pipeline/build_inputs.h"
+#include "pipeline/evaluate.h"
 #include "pipeline/mesh_object.h"
+#include "pipeline/plan.h"
 #include "solids/slice.h"
 #include "util/system.h"
 
@@ -68,6 +74,56 @@ const char* format_name(LayerFormat f) {
   return "";
 }
 
+// Runs one step of a job on every process, then lets every process know whether any failed: the
+// one that failed rethrows its error, the others stop with an error of the same kind naming it,
+// so the job ends everywhere with nothing written. Alone, just runs the step.
+template <typename Step>
+void in_every_rank(SliceRanks* ranks, Step&& step) {
+  if (!ranks) {
+    step();
+    return;
+  }
+  std::exception_ptr error;
+  int64_t kind = 0;  // 1 internal, 2 input, 3 files, 4 budget, 5 checks, 6 cancelled
+  try {
+    step();
+  } catch (const InvalidInput&) {
+    kind = 2, error = std::current_exception();
+  } catch (const IoError&) {
+    kind = 3, error = std::current_exception();
+  } catch (const ResourceLimit&) {
+    kind = 4, error = std::current_exception();
+  } catch (const CheckFailed&) {
+    kind = 5, error = std::current_exception();
+  } catch (const Cancelled&) {
+    kind = 6, error = std::current_exception();
+  } catch (...) {
+    kind = 1, error = std::current_exception();
+  }
+  // The worst kind, and among the processes with it the first.
+  const int64_t count = ranks->size();
+  const int64_t worst = ranks->max(kind == 0 ? 0 : kind * count + (count - 1 - ranks->rank()));
+  if (worst == 0) return;
+  if (error) std::rethrow_exception(error);
+  const std::string message = "process " + std::to_string(count - 1 - worst % count) + " of " + std::to_string(count) +
+                              " failed (its message says why); this one stopped with it and nothing was written";
+  switch (worst / count) {
+    case 2: throw InvalidInput(message);
+    case 3: throw IoError(message);
+    case 4: throw ResourceLimit(message);
+    case 5: throw CheckFailed(message);
+    case 6: throw Cancelled(message);
+    default: throw InternalError(message);
+  }
+}
+
+// Length-prefixed texts in one string (what processes hand each other).
+void append_text(std::string& out, const std::string& text) {
+  const uint64_t n = text.size();
+  out.append(reinterpret_cast<const char*>(&n), sizeof n);
+  out += text;
+}
+
 }  // namespace
 
 LayerFormat layer_format_from_path(const std::string& path, bool binary) {
@@ -83,34 +139,35 @@ LayerFormat layer_format_from_path(const std::string& path, bool binary) {
   return LayerFormat::kPng;
 }
 
-SlicedLayers slice_volume(const Volume& volume, const LayerSettings& settings, const std::string& what,
-                          uint64_t max_memory_bytes) {
-  SlicedLayers out;
-  SliceReport& report = out.report;
+LayerSlicer::LayerSlicer(const LayerSettings& settings, double voxel_size_mm, std::string what, uint64_t max_memory_bytes)
+    : settings_(settings), what_(std::move(what)) {
+  SliceReport& report = out_.report;
   report.format = settings.format;
-  report.voxel_size_mm = volume.voxel_size_mm();
-  report.layer_mm = settings.layer_mm > 0 ? settings.layer_mm : volume.voxel_size_mm();
-  report.pixel_mm = settings.pixel_mm > 0 ? settings.pixel_mm : volume.voxel_size_mm();
+  report.voxel_size_mm = voxel_size_mm;
+  report.layer_mm = settings.layer_mm > 0 ? settings.layer_mm : voxel_size_mm;
+  report.pixel_mm = settings.pixel_mm > 0 ? settings.pixel_mm : voxel_size_mm;
   report.tolerance_mm = settings.tolerance_mm >= 0 ? settings.tolerance_mm : report.pixel_mm / 4;
   for (const auto& [name, v] : {std::pair{"layer_mm", report.layer_mm}, std::pair{"pixel_mm", report.pixel_mm}})
     if (!std::isfinite(v) || v < kMinVoxelSizeMm || v > kMaxVoxelSizeMm)
-      throw InvalidInput(what + ": " + name + ": expected a length between " + std::to_string(kMinVoxelSizeMm) +
+      throw InvalidInput(what_ + ": " + name + ": expected a length between " + std::to_string(kMinVoxelSizeMm) +
                          " and " + std::to_string(kMaxVoxelSizeMm) + " mm");
-  if (!std::isfinite(report.tolerance_mm)) throw InvalidInput(what + ": tolerance_mm: expected a finite length");
-  const LayerFormat format = settings.format;
-  const Box3 box = solid_box(volume);
-  if (box.empty()) throw InvalidInput(what + " is empty: nothing is left to slice");
+  if (!std::isfinite(report.tolerance_mm)) throw InvalidInput(what_ + ": tolerance_mm: expected a finite length");
+  budget_ = max_memory_bytes ? max_memory_bytes : available_memory_bytes() / 2;
+}
 
+void LayerSlicer::start(const Box3& box, double z0_mm) {
+  SliceReport& report = out_.report;
+  const LayerFormat format = settings_.format;
   // The pixels: a margin beyond the solid's box (at least a voxel, the box's own error) keeps the
   // grid's border outside, so every contour closes.
   double p = report.pixel_mm;
-  const double margin = p * (std::ceil(volume.voxel_size_mm() / p) + 1);
-  LayerGrid grid;
+  const double margin = p * (std::ceil(report.voxel_size_mm / p) + 1);
+  LayerGrid& grid = out_.stack.grid;
   grid.pixel_mm = p;
   grid.origin_mm = {std::floor((box.min.x - margin) / p) * p, std::floor((box.min.y - margin) / p) * p};
   double width = std::ceil((box.max.x + margin - grid.origin_mm.x) / p) + 1;
   double height = std::ceil((box.max.y + margin - grid.origin_mm.y) / p) + 1;
-  const Sl1Printer& printer = settings.printer;
+  const Sl1Printer& printer = settings_.printer;
   if (format == LayerFormat::kSl1) {
     // The printer's display: the part's box centred on the bed as PrusaSlicer arranges it, pixel
     // (i, j) at bed x = (i + 1/2) * row step, y = (j + 1/2) * column step.
@@ -126,134 +183,278 @@ SlicedLayers slice_volume(const Volume& volume, const LayerSettings& settings, c
     const double margin_x = grid.pixel_mm, margin_y = grid.pixel_height_mm;
     if (box.min.x - margin_x < grid.origin_mm.x || box.max.x + margin_x > grid.origin_mm.x + (width - 1) * grid.pixel_mm ||
         box.min.y - margin_y < grid.origin_mm.y || box.max.y + margin_y > grid.origin_mm.y + (height - 1) * grid.pixel_height_mm)
-      throw InvalidInput(what + " (" + detail::fixed(box.max.x - box.min.x, 4) + " x " +
+      throw InvalidInput(what_ + " (" + detail::fixed(box.max.x - box.min.x, 4) + " x " +
                          detail::fixed(box.max.y - box.min.y, 4) + " mm) does not fit the printer's display (" +
                          detail::fixed(bed_x, 4) + " x " + detail::fixed(printer.display_height_mm, 4) + " mm)");
   }
-  const double layers = std::max(1.0, std::ceil((box.max.z - box.min.z) / report.layer_mm - 1e-9));
+  // Up to the box's top and a voxel (the interpolation's reach); empty layers on top are dropped.
+  const double layers = std::max(1.0, std::ceil((box.max.z + report.voxel_size_mm - z0_mm) / report.layer_mm - 1e-9));
   if (width * height > kMaxLayerPixels)
-    throw ResourceLimit(what + " at " + detail::fixed(p, 4) + " mm pixels needs " + std::to_string(int64_t(width)) +
+    throw ResourceLimit(what_ + " at " + detail::fixed(p, 4) + " mm pixels needs " + std::to_string(int64_t(width)) +
                         " x " + std::to_string(int64_t(height)) +
                         " pixels per layer, more than 2^28; use larger pixels (--pixel-mm, pixel_mm)");
   if (layers > kMaxLayers)
-    throw ResourceLimit(what + " needs " + std::to_string(int64_t(layers)) + " layers of " +
+    throw ResourceLimit(what_ + " needs " + std::to_string(int64_t(layers)) + " layers of " +
                         detail::fixed(report.layer_mm, 4) + " mm, more than a million; use thicker layers (--layer-mm, layer_mm)");
   grid.width = int(width);
   grid.height = int(height);
   report.width = grid.width;
   report.height = grid.height;
-  report.z0_mm = box.min.z;
-  // Memory: a layer's samples and image per thread at a time, beside the level set.
-  const uint64_t budget = max_memory_bytes ? max_memory_bytes : available_memory_bytes() / 2;
-  const uint64_t per_layer = uint64_t(grid.pixels()) * 6;
-  const uint64_t concurrency = uint64_t(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
-  if (per_layer * concurrency + volume.memory_bytes() > budget)
-    throw ResourceLimit("slicing " + what + " needs about " + format_bytes(per_layer * concurrency) +
-                        " for the layers in progress beyond its level set, more than the budget of " + format_bytes(budget));
-
-  LayerStack& stack = out.stack;
-  stack.name = settings.name;
+  report.z0_mm = z0_mm;
+  LayerStack& stack = out_.stack;
+  stack.name = settings_.name;
   stack.layer_mm = report.layer_mm;
   stack.z0_mm = report.z0_mm;
   stack.layers = size_t(layers);
-  stack.grid = grid;
   const bool cli = format == LayerFormat::kCli || format == LayerFormat::kCliBinary;
-  std::vector<std::string>& pngs = out.pngs;
-  std::vector<Contours>& contours = out.contours;
-  pngs.resize(cli ? 0 : stack.layers);
-  contours.resize(cli ? stack.layers : 0);
+  out_.pngs.resize(cli ? 0 : stack.layers);
+  out_.contours.resize(cli ? stack.layers : 0);
   report.layers.resize(stack.layers);
-  std::vector<std::vector<std::string>> problems(stack.layers);
-  {
-    Progress bar("slice", stack.layers);
-    tbb::parallel_for(size_t(0), stack.layers, [&](size_t k) {
-      LayerFigures& figures = report.layers[k];
-      figures.z_mm = report.z0_mm + (double(k) + 0.5) * report.layer_mm;
-      std::vector<float> distance = sample_layer(volume, figures.z_mm, grid);
-      const std::vector<uint8_t> image = coverage_image(distance, grid);
-      figures.image_area_mm2 = image_area_mm2(image, grid);
-      const Contours plain = as_written(contour_layer(distance, grid), format);
-      distance = {};
-      figures.contour_area_mm2 = contours_area_mm2(plain);
-      figures.contour_length_mm = contours_length_mm(plain);
-      const std::string where = "layer " + std::to_string(k) + " (z " + detail::fixed(figures.z_mm, 6) + " mm)";
-      // The image and the contours are two readings of one cross-section: their areas differ by
-      // less than a pixel's width along the boundary (measured: under a tenth of that).
-      const double allowed = 0.5 * p * figures.contour_length_mm + p * p;  // p: the larger pixel side
-      if (std::abs(figures.image_area_mm2 - figures.contour_area_mm2) > allowed)
-        problems[k].push_back(where + ": the image covers " + detail::fixed(figures.image_area_mm2, 6) + " mm2, its contours " +
-                              detail::fixed(figures.contour_area_mm2, 6) + " mm2");
-      Contours kept = plain;
-      if (cli && report.tolerance_mm > 0) kept = as_written(simplify_contours(plain, report.tolerance_mm), format);
-      ContourCheck check = check_contours(kept);
-      if (!check.valid() && cli && report.tolerance_mm > 0) {
-        figures.simplified = false;
-        kept = plain;
-        check = check_contours(kept);
-      }
-      if (!check.valid())
-        for (const std::string& problem : check.problems) problems[k].push_back(where + ": " + problem);
-      figures.contours = kept.size();
-      if (cli) {
-        contours[k] = std::move(kept);
-      } else if (format == LayerFormat::kSl1) {
-        // The display's image: rows from the bed's far x end, columns along y (as PrusaSlicer 2.5).
-        const size_t w = size_t(grid.width), h = size_t(grid.height);
-        std::vector<uint8_t> rows(image.size());
-        for (size_t r = 0; r < w; ++r)
-          for (size_t c = 0; c < h; ++c) rows[r * h + c] = image[c * w + (w - 1 - r)];
-        pngs[k] = encode_grey_png(int(h), int(w), rows);
-      } else {
-        pngs[k] = encode_layer_png(image, grid);
-      }
-      bar.advance();
-    });
+  problems_.resize(stack.layers);
+  done_.assign(stack.layers, 0);
+  started_ = true;
+}
+
+double LayerSlicer::layer_z_mm(size_t k) const {
+  return out_.report.z0_mm + (double(k) + 0.5) * out_.report.layer_mm;
+}
+
+void LayerSlicer::sample(const Volume& volume, double z_end_mm) {
+  if (!started_) throw InternalError("LayerSlicer::sample before start");
+  SliceReport& report = out_.report;
+  const LayerStack& stack = out_.stack;
+  const LayerGrid& grid = stack.grid;
+  const LayerFormat format = settings_.format;
+  const bool cli = format == LayerFormat::kCli || format == LayerFormat::kCliBinary;
+  const double p = report.pixel_mm;
+  size_t end = next_;
+  while (end < stack.layers && layer_z_mm(end) < z_end_mm) ++end;
+  if (end == next_) return;
+  // Memory: a layer's samples and image per thread at a time, beside the level set.
+  const uint64_t per_layer = uint64_t(grid.pixels()) * 6;
+  const uint64_t concurrency = uint64_t(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+  if (per_layer * concurrency + volume.memory_bytes() > budget_)
+    throw ResourceLimit("slicing " + what_ + " needs about " + format_bytes(per_layer * concurrency) +
+                        " for the layers in progress beyond its level set, more than the budget of " + format_bytes(budget_));
+  if (!bar_) bar_ = std::make_unique<Progress>("slice", stack.layers);
+  tbb::parallel_for(next_, end, [&](size_t k) {
+    LayerFigures& figures = report.layers[k];
+    figures.z_mm = layer_z_mm(k);
+    std::vector<float> distance = sample_layer(volume, figures.z_mm, grid);
+    const std::vector<uint8_t> image = coverage_image(distance, grid);
+    figures.image_area_mm2 = image_area_mm2(image, grid);
+    const Contours plain = as_written(contour_layer(distance, grid), format);
+    distance = {};
+    figures.contour_area_mm2 = contours_area_mm2(plain);
+    figures.contour_length_mm = contours_length_mm(plain);
+    const std::string where = "layer " + std::to_string(k) + " (z " + detail::fixed(figures.z_mm, 6) + " mm)";
+    // The image and the contours are two readings of one cross-section: their areas differ by
+    // less than a pixel's width along the boundary (measured: under a tenth of that).
+    const double allowed = 0.5 * p * figures.contour_length_mm + p * p;  // p: the larger pixel side
+    if (std::abs(figures.image_area_mm2 - figures.contour_area_mm2) > allowed)
+      problems_[k].push_back(where + ": the image covers " + detail::fixed(figures.image_area_mm2, 6) + " mm2, its contours " +
+                             detail::fixed(figures.contour_area_mm2, 6) + " mm2");
+    Contours kept = plain;
+    if (cli && report.tolerance_mm > 0) kept = as_written(simplify_contours(plain, report.tolerance_mm), format);
+    ContourCheck check = check_contours(kept);
+    if (!check.valid() && cli && report.tolerance_mm > 0) {
+      figures.simplified = false;
+      kept = plain;
+      check = check_contours(kept);
+    }
+    if (!check.valid())
+      for (const std::string& problem : check.problems) problems_[k].push_back(where + ": " + problem);
+    figures.contours = kept.size();
+    if (cli) {
+      out_.contours[k] = std::move(kept);
+    } else if (format == LayerFormat::kSl1) {
+      // The display's image: rows from the bed's far x end, columns along y (as PrusaSlicer 2.5).
+      const size_t w = size_t(grid.width), h = size_t(grid.height);
+      std::vector<uint8_t> rows(image.size());
+      for (size_t r = 0; r < w; ++r)
+        for (size_t c = 0; c < h; ++c) rows[r * h + c] = image[c * w + (w - 1 - r)];
+      out_.pngs[k] = encode_grey_png(int(h), int(w), rows);
+    } else {
+      out_.pngs[k] = encode_layer_png(image, grid);
+    }
+    if (spool_ && !cli) {
+      spool_(k, out_.pngs[k]);
+      out_.pngs[k] = std::string();
+    }
+    done_[k] = 1;
+    bar_->advance();
+  });
+  next_ = end;
+}
+
+void LayerSlicer::skip_to(double z_mm) {
+  if (!started_ || next_ != first_) throw InternalError("LayerSlicer::skip_to after sampling");
+  while (next_ < out_.stack.layers && layer_z_mm(next_) < z_mm) ++next_;
+  first_ = next_;
+}
+
+namespace {
+
+template <typename T>
+void put(std::string& out, const T& v) {
+  out.append(reinterpret_cast<const char*>(&v), sizeof v);
+}
+
+struct Reader {
+  const std::string& bytes;
+  size_t at = 0;
+  template <typename T>
+  T get() {
+    T v;
+    if (at + sizeof v > bytes.size()) throw InternalError("a process's layers were cut short");
+    std::memcpy(&v, bytes.data() + at, sizeof v);
+    at += sizeof v;
+    return v;
   }
-  // The box may reach a little past the solid (its interpolation): empty layers on top are dropped.
+  std::string text() {
+    const uint64_t n = get<uint64_t>();
+    if (at + n > bytes.size()) throw InternalError("a process's layers were cut short");
+    std::string t = bytes.substr(at, n);
+    at += n;
+    return t;
+  }
+};
+
+}  // namespace
+
+std::string LayerSlicer::pack() const {
+  std::string out;
+  put<uint64_t>(out, first_);
+  put<uint64_t>(out, next_);
+  for (size_t k = first_; k < next_; ++k) {
+    const LayerFigures& f = out_.report.layers[k];
+    put(out, f.z_mm);
+    put(out, f.image_area_mm2);
+    put(out, f.contour_area_mm2);
+    put(out, f.contour_length_mm);
+    put<uint64_t>(out, f.contours);
+    put<uint8_t>(out, f.simplified ? 1 : 0);
+    put<uint64_t>(out, problems_[k].size());
+    for (const std::string& problem : problems_[k]) append_text(out, problem);
+    const Contours none;
+    const Contours& loops = k < out_.contours.size() ? out_.contours[k] : none;
+    put<uint64_t>(out, loops.size());
+    for (const auto& loop : loops) {
+      put<uint64_t>(out, loop.size());
+      for (const Vec2d& p : loop) {
+        put(out, p.x);
+        put(out, p.y);
+      }
+    }
+  }
+  return out;
+}
+
+std::vector<std::string> LayerSlicer::unpack(const std::string& bytes) {
+  Reader in{bytes};
+  const uint64_t first = in.get<uint64_t>(), end = in.get<uint64_t>();
+  if (first > end || end > out_.stack.layers) throw InternalError("a process's layers do not fit the stack");
+  for (size_t k = first; k < end; ++k) {
+    LayerFigures& f = out_.report.layers[k];
+    f.z_mm = in.get<double>();
+    f.image_area_mm2 = in.get<double>();
+    f.contour_area_mm2 = in.get<double>();
+    f.contour_length_mm = in.get<double>();
+    f.contours = in.get<uint64_t>();
+    f.simplified = in.get<uint8_t>() != 0;
+    problems_[k].resize(in.get<uint64_t>());
+    for (std::string& problem : problems_[k]) problem = in.text();
+    Contours loops(in.get<uint64_t>());
+    for (auto& loop : loops) {
+      loop.resize(in.get<uint64_t>());
+      for (Vec2d& p : loop) {
+        p.x = in.get<double>();
+        p.y = in.get<double>();
+      }
+    }
+    if (k < out_.contours.size()) out_.contours[k] = std::move(loops);
+    if (done_[k]) throw InternalError("layer " + std::to_string(k) + " was cut twice");
+    done_[k] = 1;
+  }
+  std::vector<std::string> texts;
+  while (in.at < bytes.size()) texts.push_back(in.text());
+  return texts;
+}
+
+SlicedLayers LayerSlicer::finish() {
+  if (!started_) throw InternalError("LayerSlicer::finish before start");
+  if (std::count(done_.begin(), done_.end(), 0) != 0) throw InternalError("LayerSlicer::finish with layers not sampled");
+  bar_.reset();
+  SliceReport& report = out_.report;
+  LayerStack& stack = out_.stack;
+  const bool cli = report.format == LayerFormat::kCli || report.format == LayerFormat::kCliBinary;
+  // The box may reach a little past the solid: empty layers on top are dropped.
   while (stack.layers > 1 && report.layers.back().contours == 0 && report.layers.back().image_area_mm2 == 0) {
     --stack.layers;
     report.layers.pop_back();
-    problems.pop_back();
-    if (cli) contours.pop_back();
-    else pngs.pop_back();
+    problems_.pop_back();
+    if (cli) out_.contours.pop_back();
+    else out_.pngs.pop_back();
   }
-  for (auto& layer : problems)
+  for (auto& layer : problems_)
     for (auto& problem : layer) report.problems.push_back(std::move(problem));
   report.valid = report.problems.empty();
-  if (format == LayerFormat::kSl1) {
-    out.printer = printer;
-    out.job.name = settings.name;
-    out.job.layer_mm = report.layer_mm;
-    out.job.layers = stack.layers;
+  if (report.format == LayerFormat::kSl1) {
+    const Sl1Printer& printer = settings_.printer;
+    out_.printer = printer;
+    out_.job.name = settings_.name;
+    out_.job.layer_mm = report.layer_mm;
+    out_.job.layers = stack.layers;
     std::vector<double> areas;
     for (const LayerFigures& f : report.layers) {
       areas.push_back(f.image_area_mm2);
-      out.job.used_ml += f.image_area_mm2 * report.layer_mm / 1000;
+      out_.job.used_ml += f.image_area_mm2 * report.layer_mm / 1000;
     }
-    out.job.print_s = sl1_print_seconds(areas, report.layer_mm, printer, &out.job.slow_layers);
+    out_.job.print_s = sl1_print_seconds(areas, report.layer_mm, printer, &out_.job.slow_layers);
   }
-  return out;
+  return std::move(out_);
+}
+
+SlicedLayers slice_volume(const Volume& volume, const LayerSettings& settings, const std::string& what,
+                          uint64_t max_memory_bytes, const Box3* planned_box) {
+  LayerSlicer slicer(settings, volume.voxel_size_mm(), what, max_memory_bytes);
+  const Box3 box = solid_box(volume);
+  if (box.empty()) throw InvalidInput(what + " is empty: nothing is left to slice");
+  slicer.start(planned_box ? *planned_box : box, box.min.z);
+  slicer.sample(volume, std::numeric_limits<double>::infinity());
+  return slicer.finish();
+}
+
+std::vector<ZipEntry> layer_archive_entries(const SlicedLayers& sliced, std::vector<std::string>& texts,
+                                            const std::vector<std::string>* image_files) {
+  std::vector<ZipEntry> entries;
+  texts.clear();
+  texts.reserve(2);  // the entries point into them
+  std::vector<std::string> names;
+  if (sliced.report.format == LayerFormat::kSl1) {
+    texts.push_back(sl1_config_ini(sliced.job, sliced.printer));
+    texts.push_back(sl1_prusaslicer_ini(sliced.job, sliced.printer));
+    entries = {{"config.ini", texts[0], true, {}}, {"prusaslicer.ini", texts[1], true, {}}};
+    for (size_t k = 0; k < sliced.stack.layers; ++k) names.push_back(sl1_layer_name(sliced.job.name, k));
+  } else {
+    texts.push_back(layer_manifest(sliced.stack));
+    entries = {{"manifest.json", texts[0], true, {}}};
+    for (size_t k = 0; k < sliced.stack.layers; ++k) names.push_back(layer_file_name(k));
+  }
+  for (size_t k = 0; k < sliced.stack.layers; ++k)
+    entries.push_back({names[k], image_files ? std::string_view() : std::string_view(sliced.pngs[k]), false,
+                       image_files ? (*image_files)[k] : std::string()});
+  return entries;
 }
 
 std::string layers_file(const SlicedLayers& sliced, const std::string& where) {
   switch (sliced.report.format) {
     case LayerFormat::kCli: return cli_file(sliced.stack, sliced.contours, false);
     case LayerFormat::kCliBinary: return cli_file(sliced.stack, sliced.contours, true);
-    case LayerFormat::kPngZip: {
-      const std::string manifest = layer_manifest(sliced.stack);
-      std::vector<ZipEntry> entries;
-      entries.push_back({"manifest.json", manifest, true});
-      for (size_t k = 0; k < sliced.stack.layers; ++k) entries.push_back({layer_file_name(k), sliced.pngs[k], false});
-      return zip_archive(entries, where);
-    }
+    case LayerFormat::kPngZip:
     case LayerFormat::kSl1: {
-      const std::string config = sl1_config_ini(sliced.job, sliced.printer);
-      const std::string profile = sl1_prusaslicer_ini(sliced.job, sliced.printer);
-      std::vector<std::string> names;
-      for (size_t k = 0; k < sliced.stack.layers; ++k) names.push_back(sl1_layer_name(sliced.job.name, k));
-      std::vector<ZipEntry> entries = {{"config.ini", config, true}, {"prusaslicer.ini", profile, true}};
-      for (size_t k = 0; k < sliced.stack.layers; ++k) entries.push_back({names[k], sliced.pngs[k], false});
-      return zip_archive(entries, where);
+      std::vector<std::string> texts;
+      return zip_archive(layer_archive_entries(sliced, texts), where);
     }
     case LayerFormat::kPng: break;
   }
@@ -276,38 +477,213 @@ SliceReport slice_recipe(const std::string& recipe_path, const std::string& outp
   settings.tolerance_mm = options.tolerance_mm;
 
   StageTimer timer;
-  ObjectOptions object_options;
-  object_options.max_memory_bytes = options.run.max_memory_bytes;
-  object_options.progress = sink;
-  const Volume volume = evaluate_object(recipe, settings.name, object_options);
-  timer.start("slice");
-  SlicedLayers sliced =
-      slice_volume(volume, settings, recipe.file + ": \"" + settings.name + "\"", options.run.max_memory_bytes);
-  SliceReport& report = sliced.report;
-  report.output = output;
-  report.object = settings.name;
-  timer.start("write");
-  if (report.valid) {
-    throw_if_cancelled(sink);
-    OutputTransaction transaction;
-    if (settings.format == LayerFormat::kPng) {
-      OutputFolder folder(output);
-      for (size_t k = 0; k < sliced.stack.layers; ++k) {
-        write_whole_file(transaction.stage((fs::path(output) / layer_file_name(k)).string()), sliced.pngs[k]);
-        report.bytes += sliced.pngs[k].size();
+  timer.start("build");
+  Recipe only = recipe_for_object(recipe, settings.name);
+  only.outputs.front().layers = RecipeOutput::Layers{};  // cut from the level set: no mesh to reserve memory for
+  const uint64_t budget = options.run.max_memory_bytes ? options.run.max_memory_bytes : available_memory_bytes() / 2;
+  const BuiltInputs inputs = build_inputs(only, budget);
+  const Plan p = plan(only);
+  const std::string what = recipe.file + ": \"" + settings.name + "\"";
+  const MemoryEstimator estimator(only, p, inputs);
+  const ObjectExtent extent = estimator.extents().at(settings.name);
+  const double h = only.voxel_size_mm, band = h * only.band_voxels;
+
+  // Slabs of whole leaves (8 voxels) stacked from below the box; each is evaluated with a halo on
+  // both sides deep enough that the object there equals the whole run's, and a band and a voxel
+  // more for the layers' interpolation and the lowest point's search.
+  const double leaf = 8 * h;
+  const double halo = std::ceil((extent.halo_mm + band + 2 * h) / leaf) * leaf;
+  const double bottom = std::floor((extent.box.min.z - band - h) / leaf) * leaf;
+  const double top = extent.box.max.z + band + 2 * h;
+  const double whole = std::ceil((top - bottom) / leaf) * leaf;
+  auto slabs_of = [&](double height) {
+    std::vector<ZSlab> slabs;
+    for (double lo = bottom; lo < top; lo += height) slabs.push_back({lo - halo, lo + height + halo});
+    return slabs;
+  };
+  if (options.slab_mm < 0 || !std::isfinite(options.slab_mm))
+    throw InvalidInput(what + ": slab_mm: expected a positive height in mm, or 0 to choose one");
+  double slab_height = 0;  // 0: the whole part at once
+  if (options.slab_mm > 0) {
+    slab_height = std::ceil(options.slab_mm / leaf - 1e-9) * leaf;
+  } else if (estimator.bytes() > budget) {
+    // The highest slabs that fit (in leaves): the estimate grows with their height.
+    size_t lo = 1, hi = size_t(std::ceil(whole / leaf));
+    if (estimator.bytes(slabs_of(leaf)) > budget)
+      throw ResourceLimit(what + ": even slabs of " + detail::fixed(leaf, 4) + " mm (with a halo of " +
+                          detail::fixed(halo, 4) + " mm below and above) need more than the budget of " +
+                          format_bytes(budget) + "; use a larger voxel size or more memory");
+    while (hi - lo > 1) {
+      const size_t mid = (lo + hi) / 2;
+      (estimator.bytes(slabs_of(double(mid) * leaf)) <= budget ? lo : hi) = mid;
+    }
+    slab_height = double(lo) * leaf;
+  }
+
+  // A job over several processes: each takes a block of the slabs (split into as many as there are
+  // processes when the whole part would fit one).
+  SliceRanks* ranks = options.ranks && options.ranks->size() > 1 ? options.ranks : nullptr;
+  const int rank_count = ranks ? ranks->size() : 1, me = ranks ? ranks->rank() : 0;
+  if (ranks && (slab_height == 0 || slab_height * rank_count > whole))
+    slab_height = std::ceil(whole / leaf / rank_count) * leaf;
+  if (slab_height >= whole) slab_height = 0;
+  const std::vector<ZSlab> slabs = slab_height > 0 ? slabs_of(slab_height) : std::vector<ZSlab>{{bottom, bottom + whole}};
+  const size_t first_slab = slabs.size() * size_t(me) / size_t(rank_count);
+  const size_t end_slab = slabs.size() * size_t(me + 1) / size_t(rank_count);
+  auto slab_lo = [&](size_t i) { return slab_height > 0 ? slabs[i].lo_mm + halo : -std::numeric_limits<double>::infinity(); };
+  auto slab_hi = [&](size_t i) { return slab_height > 0 ? slabs[i].hi_mm - halo : std::numeric_limits<double>::infinity(); };
+
+  LayerSlicer slicer(settings, h, what, budget);
+  // Images go to disk as they are made, hidden beside the output, so memory holds a slab and the
+  // layers in progress only; they become the output when every layer passed.
+  const bool images = settings.format != LayerFormat::kCli && settings.format != LayerFormat::kCliBinary;
+  std::optional<OutputFolder> folder;
+  if (settings.format == LayerFormat::kPng && me == 0) folder.emplace(output);
+  const fs::path spool_dir = fs::path(output).parent_path();
+  OutputTransaction spool;
+  std::vector<std::string> spooled;
+  std::mutex spool_mutex;
+  if (images)
+    slicer.spool_images([&](size_t k, const std::string& png) {
+      std::string path;
+      {
+        std::lock_guard<std::mutex> lock(spool_mutex);
+        if (spooled.size() <= k) spooled.resize(k + 1);
+        path = spooled[k] = spool.stage((spool_dir / ("spool-" + fs::path(output).filename().string() + "-" +
+                                                      layer_file_name(k))).string());
       }
-      const std::string manifest = layer_manifest(sliced.stack);
-      write_whole_file(transaction.stage((fs::path(output) / "manifest.json").string()), manifest);
-      report.bytes += manifest.size();
-      transaction.commit();
-      folder.keep();
-    } else {
-      const std::string bytes = layers_file(sliced, output);
-      write_whole_file(transaction.stage(output), bytes);
-      report.bytes = bytes.size();
-      transaction.commit();
+      write_whole_file(path, png);
+      // The archive entry takes the file's mode: the same as an entry made in memory.
+      fs::permissions(path, fs::perms(0666));
+    });
+  uint64_t estimate = 0;
+  std::map<std::string, Volume> converted_meshes;  // imported meshes, converted once
+  auto evaluate_slab = [&](size_t i) {
+    throw_if_cancelled(sink);
+    EvaluateOptions evaluate_options;
+    evaluate_options.max_memory_bytes = budget;
+    evaluate_options.slab = slab_height > 0 ? &slabs[i] : nullptr;
+    evaluate_options.converted_meshes = &converted_meshes;
+    evaluate_options.estimator = &estimator;
+    timer.start("evaluate");
+    Evaluation evaluation = evaluate(only, p, inputs, evaluate_options);
+    estimate = std::max(estimate, evaluation.memory_estimate_bytes);
+    Volume volume = evaluation.take(settings.name);
+    timer.start("slice");
+    return volume;
+  };
+
+  // 1. Up to the first slab holding solid (the ones below are dropped): the solid's lowest point,
+  // where no voxel above that slab's band reaches below its top. Over several processes, the lowest
+  // of theirs, and the lowest process that found one.
+  size_t kept_slab = end_slab;
+  Volume kept;
+  double lowest = std::numeric_limits<double>::infinity(), first_rank = 0;
+  in_every_rank(ranks, [&] {
+    for (size_t i = first_slab; i < end_slab; ++i) {
+      Volume volume = evaluate_slab(i);
+      const Box3 found = slab_height > 0 ? solid_box(volume, slab_lo(i), slab_hi(i) + band + h) : solid_box(volume);
+      if (!found.empty()) {
+        lowest = found.min.z;
+        kept_slab = i;
+        kept = std::move(volume);
+        break;
+      }
+    }
+  });
+  if (ranks) {
+    first_rank = ranks->min(std::isfinite(lowest) ? double(me) : double(rank_count));
+    lowest = ranks->min(lowest);
+  }
+  if (!std::isfinite(lowest)) throw InvalidInput(what + " is empty: nothing is left to slice");
+  slicer.start(extent.box, lowest);
+
+  // 2. Every layer cut from the slab its plane lies in (the first slab holding solid also cuts those
+  // below it). A later process first goes back over the slabs it dropped.
+  in_every_rank(ranks, [&] {
+    // Nothing of the solid below: its layers are the next process's.
+    if (first_slab == end_slab || me < int(first_rank)) return;
+    if (me > int(first_rank)) {
+      slicer.skip_to(slab_lo(first_slab));
+      for (size_t i = first_slab; i < kept_slab; ++i) slicer.sample(evaluate_slab(i), slab_hi(i));
+    }
+    if (kept_slab == end_slab) return;
+    slicer.sample(kept, slab_hi(kept_slab));
+    kept = Volume();
+    for (size_t i = kept_slab + 1; i < end_slab; ++i) slicer.sample(evaluate_slab(i), slab_hi(i));
+  });
+
+  // 3. The first process gathers every layer (figures, problems, contours, where the images are).
+  if (ranks) {
+    std::vector<std::string> gathered;
+    in_every_rank(ranks, [&] {
+      std::string mine = slicer.pack();
+      for (size_t k = 0; k < spooled.size(); ++k)
+        if (!spooled[k].empty()) append_text(mine, std::to_string(k) + "\n" + spooled[k]);
+      gathered = ranks->gather(mine);
+    });
+    if (me != 0) {
+      // The first process writes; the images stay until it has.
+      SliceReport report;
+      report.output = output;
+      report.object = settings.name;
+      in_every_rank(ranks, [] {});
+      report.valid = ranks->max(0) == 0;
+      timer.stop();
+      report.stage_seconds = timer.seconds();
+      return report;
+    }
+    for (size_t r = 1; r < gathered.size(); ++r) {
+      const std::vector<std::string> paths = slicer.unpack(gathered[r]);
+      for (const std::string& entry : paths) {
+        const size_t split = entry.find('\n');
+        const size_t k = std::stoul(entry.substr(0, split));
+        if (spooled.size() <= k) spooled.resize(k + 1);
+        spooled[k] = entry.substr(split + 1);
+      }
     }
   }
+  SliceReport report;
+  in_every_rank(ranks, [&] {
+    SlicedLayers sliced = slicer.finish();
+    sliced.report.slabs = slabs.size();
+    sliced.report.slab_mm = slab_height;
+    sliced.report.halo_mm = slab_height > 0 ? halo : 0;
+    sliced.report.memory_estimate_bytes = estimate;
+    sliced.report.output = output;
+    sliced.report.object = settings.name;
+    timer.start("write");
+    if (sliced.report.valid) {
+      throw_if_cancelled(sink);
+      OutputTransaction transaction;
+      if (settings.format == LayerFormat::kPng) {
+        for (size_t k = 0; k < sliced.stack.layers; ++k) {
+          const std::string staged = transaction.stage((fs::path(output) / layer_file_name(k)).string());
+          fs::rename(spooled[k], staged);
+          sliced.report.bytes += fs::file_size(staged);
+        }
+        const std::string manifest = layer_manifest(sliced.stack);
+        write_whole_file(transaction.stage((fs::path(output) / "manifest.json").string()), manifest);
+        sliced.report.bytes += manifest.size();
+        transaction.commit();
+        folder->keep();
+      } else if (images) {
+        std::vector<std::string> texts;
+        const std::string staged = transaction.stage(output);
+        write_zip_archive(layer_archive_entries(sliced, texts, &spooled), staged, output);
+        sliced.report.bytes = fs::file_size(staged);
+        transaction.commit();
+      } else {
+        const std::string bytes = layers_file(sliced, output);
+        write_whole_file(transaction.stage(output), bytes);
+        sliced.report.bytes = bytes.size();
+        transaction.commit();
+      }
+    }
+    report = std::move(sliced.report);
+  });
+  if (ranks) ranks->max(report.valid ? 0 : 1);
+  spool.rollback();
   timer.stop();
   report.stage_seconds = timer.seconds();
   return report;
@@ -329,6 +705,8 @@ nlohmann::json to_json(const SliceReport& r) {
           {"voxel_size_mm", r.voxel_size_mm}, {"z0_mm", r.z0_mm},        {"width", r.width},
           {"height", r.height},       {"layer_count", r.layers.size()},  {"bytes", r.bytes},
           {"valid", r.valid},         {"problems", r.problems},          {"stage_seconds", stages},
+          {"slabs", r.slabs},         {"slab_mm", r.slab_mm},            {"halo_mm", r.halo_mm},
+          {"memory_estimate_bytes", r.memory_estimate_bytes},
           {"layers", layers}};
 }
 

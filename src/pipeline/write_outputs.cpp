@@ -216,7 +216,11 @@ RunReport write_outputs(const Recipe& recipe, const Plan& plan, Evaluation&& eva
         settings.layer_mm = out.layers->layer_mm;
         settings.pixel_mm = out.layers->pixel_mm;
         settings.tolerance_mm = out.layers->tolerance_mm;
-        const SlicedLayers sliced = slice_volume(volume, settings, recipe.file + ": " + out.json_path + " (\"" + object + "\")", budget);
+        // The pixels over the object's planned box, as `lacuna slice` has them.
+        const auto extent = evaluation.extents.find(object);
+        const SlicedLayers sliced =
+            slice_volume(volume, settings, recipe.file + ": " + out.json_path + " (\"" + object + "\")", budget,
+                         extent != evaluation.extents.end() ? &extent->second.box : nullptr);
         const SliceReport& s = sliced.report;
         OutputReport entry;
         entry.file = final_path;

@@ -33,5 +33,10 @@ void require_mesh_memory(const Volume& v, uint64_t budget, const std::string& wh
   if (need > budget) throw ResourceLimit(refusal(what, need, budget, vopt));
 }
 
+void require_surface_memory(const Volume& v, uint64_t budget, const std::string& what, const VolumeOptions& vopt) {
+  const uint64_t need = estimate_from_voxels(v.active_voxel_count(), vopt).surface_bytes + current_memory_bytes();
+  if (need > budget) throw ResourceLimit(refusal(what, need, budget, vopt));
+}
+
 }  // namespace detail
 }  // namespace lacuna

@@ -22,5 +22,9 @@ std::string refusal(const std::string& what, uint64_t need, uint64_t budget, con
 void require_mesh_memory(const Volume& v, uint64_t budget, const std::string& what, const VolumeOptions& vopt,
                          double simplify_mm = 0);
 
+// Throws ResourceLimit before extracting a level set's surface to distance it again (an offset, a
+// shell, an infill's skin) when that surface would not fit next to what is in use now.
+void require_surface_memory(const Volume& v, uint64_t budget, const std::string& what, const VolumeOptions& vopt);
+
 }  // namespace detail
 }  // namespace lacuna

@@ -1,0 +1,81 @@
+"""`mpirun -np 2 lacuna slice` on one machine: the ranks split the slabs, rank 0 gathers the layers
+and writes; the files are the same bytes as one process's, and a rank that fails ends the job with
+its message and nothing on disk. Skipped where mpirun is missing or lacuna was built without MPI."""
+
+import json
+import os
+import shutil
+import subprocess
+
+import pytest
+
+from conftest import BINARY, SOURCE_DIR
+
+MPIRUN = shutil.which("mpirun")
+
+
+def with_mpi():
+    if not MPIRUN:
+        pytest.skip("mpirun is not installed (scripts/setup.sh installs openmpi-bin)")
+    version = subprocess.run([BINARY, "--version"], capture_output=True, text=True).stdout
+    if "MPI" not in version:
+        pytest.skip("this lacuna was built without MPI")
+
+
+def mpirun(ranks, command):
+    """`command` (a list) run as `ranks` ranks of one job, one thread each."""
+    launcher = [MPIRUN, "-np", str(ranks), "--oversubscribe"]
+    if os.geteuid() == 0:
+        launcher.append("--allow-run-as-root")
+    return subprocess.run(launcher + command, capture_output=True, text=True, timeout=600)
+
+
+def files_of(path):
+    if path.is_dir():
+        return {p.name: p.read_bytes() for p in sorted(path.iterdir())}
+    return {path.name: path.read_bytes()}
+
+
+CASES = [
+    # An imported hull filled with a lattice (a mesh clipped per slab, an infill's skin), as images.
+    ("egg_infill.json", ["--voxel-size", "0.3"], "egg.zip"),
+    # A shell (an inward offset), as CLI contours gathered from both ranks.
+    ("hollow_sphere.json", [], "sphere.cli"),
+    # A streamed CIFS input, as a folder of PNGs, and as an SL1 archive.
+    ("menger_sponge.json", [], "sponge"),
+    ("menger_sponge.json", [], "sponge.sl1"),
+]
+
+
+@pytest.mark.parametrize("recipe,extra,name", CASES)
+def test_two_ranks_write_one_process_bytes(tmp_path, recipe, extra, name):
+    with_mpi()
+    path = SOURCE_DIR / "samples" / recipe
+    alone = subprocess.run([BINARY, "slice", str(path), "-o", str(tmp_path / ("alone-" + name)), "--quiet", *extra],
+                           capture_output=True, text=True)
+    assert alone.returncode == 0, alone.stderr
+    job = mpirun(2, [BINARY, "slice", str(path), "-o", str(tmp_path / ("ranks-" + name)), "--json", "--threads", "1", *extra])
+    assert job.returncode == 0, job.stderr
+    report = json.loads(job.stdout)  # rank 0 alone prints
+    assert report["valid"] and report["slabs"] >= 2
+    mine, theirs = files_of(tmp_path / ("alone-" + name)), files_of(tmp_path / ("ranks-" + name))
+    assert len(mine) == len(theirs) and len(mine) >= 1
+    for (a, bytes_a), (b, bytes_b) in zip(sorted(mine.items()), sorted(theirs.items())):
+        assert a.replace("alone-", "") == b.replace("ranks-", "")
+        assert bytes_a == bytes_b, a
+    # Nothing else beside them: the ranks' spooled images are gone.
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(["alone-" + name, "ranks-" + name])
+
+
+def test_a_failing_rank_fails_the_job_and_leaves_nothing(tmp_path):
+    with_mpi()
+    recipe = SOURCE_DIR / "samples" / "hollow_sphere.json"
+    out = tmp_path / "layers.zip"
+    # Rank 1 alone gets a budget far too small for its slabs: it fails while evaluating them.
+    script = ('if [ "$OMPI_COMM_WORLD_RANK" = 1 ]; then budget=0.000001; else budget=8; fi; '
+              f'exec "{BINARY}" slice "{recipe}" -o "{out}" --slab-mm 4 --max-memory $budget')
+    job = mpirun(2, ["sh", "-c", script])
+    assert job.returncode == 3, job.stderr  # a resource limit, from every rank
+    assert "more than the budget" in job.stderr  # rank 1's own message
+    assert "process 1 of 2 failed" in job.stderr  # rank 0's
+    assert list(tmp_path.iterdir()) == []
