@@ -529,6 +529,22 @@ TEST(Cli, CurvePointsAndFillRate) {
   EXPECT_NEAR(f["fill_rate"].get<double>(), 1.75 / 4, 1e-12);
   EXPECT_NEAR(f["fill_rate_simple"].get<double>(), 3 * 0.5 / 4, 1e-12);
   EXPECT_EQ(f["segments"], 3);
+  // On a surface: in the plane, the same H_1 as round-ended tubes of diameter 0.5: 3 x 0.5 less the two
+  // bends' inner squares (0.25^2 each) plus their outer quarter disks and the two end half disks.
+  const double round_ends = 3 * 0.5 - 2 * 0.0625 + 2 * M_PI * 0.0625 / 4 + M_PI * 0.0625;
+  Result plane = lacuna("curve fill-rate --kind hilbert --orders 1 --width 0.5 --samples 2000 --json --surface plane",
+                        dir.path());
+  ASSERT_EQ(plane.code, 0) << plane.err;
+  EXPECT_NEAR(nlohmann::json::parse(plane.out)["area"].get<double>(), 4, 1e-9);
+  EXPECT_NEAR(nlohmann::json::parse(plane.out)["fill_rate"].get<double>(), round_ends / 4, 1e-3);
+  // The cube's six faces, area 24, one closed curve through them.
+  Result cube = lacuna("curve fill-rate --kind hilbert --orders 2 --width 0.1 --json --surface cube", dir.path());
+  ASSERT_EQ(cube.code, 0) << cube.err;
+  const nlohmann::json c = nlohmann::json::parse(cube.out);
+  EXPECT_NEAR(c["area"].get<double>(), 24, 1e-8);
+  EXPECT_GT(c["fill_rate"].get<double>(), 0.1);
+  EXPECT_LT(c["fill_rate"].get<double>(), c["fill_rate_simple"].get<double>());
+  EXPECT_EQ(lacuna("curve fill-rate --surface cylinder --samples 5", dir.path()).code, 2);
   Result bad = lacuna("curve fill-rate --kind peano --orders 1..3", dir.path());
   EXPECT_EQ(bad.code, 2);
   EXPECT_NE(bad.err.find("--kind"), std::string::npos) << bad.err;

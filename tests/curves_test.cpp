@@ -260,6 +260,76 @@ double sampled_fill_rate(const std::vector<Polyline2>& set, double w) {
   return double(std::count(inside.begin(), inside.end(), 1)) / (double(n) * n);
 }
 
+// The surface's area and the tubes' footprint, integrated over the whole square in one call.
+curves::SurfaceCoverage whole_coverage(const curves::SurfaceMap& map, const std::vector<Polyline3>& lines, double radius,
+                                       int n) {
+  return curves::surface_coverage(map, curves::TubeFootprint(lines, radius), n, 0, n);
+}
+
+TEST(FillRate, SurfaceAreasMatchTheClosedForms) {
+  const std::vector<Polyline3> none;
+  // The sphere's image of the square: the area element of inverse stereographic projection is
+  // 4 / (1 + X^2 + Y^2)^2; integrated over Y in closed form, over X by Simpson's rule.
+  double sphere = 0;
+  const int steps = 20000;
+  for (int i = 0; i <= steps; ++i) {
+    const double x = -1 + 2.0 * i / steps, a2 = 1 + x * x, a = std::sqrt(a2);
+    const double inner = 1 / (a2 * (a2 + 1)) + std::atan(1 / a) / (a2 * a);
+    sphere += inner * (i == 0 || i == steps ? 1 : i % 2 ? 4 : 2);
+  }
+  sphere *= 4 * (2.0 / steps) / 3;
+  // The whole cylinder, torus (major radius 1.5, minor 1) and cone (slant sqrt 5), a cube's face.
+  const std::pair<curves::SurfaceMap, double> surfaces[] = {
+      {curves::sphere_map(), sphere},
+      {curves::cylinder_map(), 4 * M_PI},
+      {curves::torus_map(), 4 * M_PI * M_PI * 1.5},
+      {curves::cone_map(), M_PI * std::sqrt(5.0)},
+      {curves::cube_face_map(2), 4.0}};
+  for (const auto& [map, area] : surfaces) {
+    const curves::SurfaceCoverage c = whole_coverage(map, {Polyline3{{Vec3d{9, 9, 9}}, false}}, 0.01, 800);
+    EXPECT_NEAR(c.area, area, 1e-4 * area) << map.name;
+    EXPECT_EQ(c.covered_area, 0) << map.name;
+    EXPECT_EQ(c.samples, 800u * 800u);
+  }
+  EXPECT_THROW(curves::TubeFootprint(none, 0), InvalidInput);
+  EXPECT_THROW(whole_coverage(curves::sphere_map(), none, 0.1, 8), InvalidInput);
+}
+
+TEST(FillRate, OnTheCylinderItIsThePlanarRateUnrolled) {
+  // The cylinder is the rectangle (-pi, pi) x (-1, 1) rolled up: tubes along the curves drawn on it
+  // cover what round-ended strokes along the unrolled curves cover of the rectangle (to the chord's
+  // bulge, (r / 1)^2 / 24 relatively). The planar union here is exact (convex_union_area) with each
+  // segment's rectangle and a 128-gon at each point.
+  const double r = 0.03;
+  for (const auto& [kind, order] : {std::pair{CurveKind::kHilbert, 3}, std::pair{CurveKind::kSierpinski, 2}}) {
+    const std::vector<Polyline2> planar = curves::polylines_of(curves::superposition(kind, {order}));
+    curves::MapOptions options;
+    options.tolerance_mm = 1e-6;
+    std::vector<Polyline3> mapped;
+    std::vector<std::vector<Vec2d>> strokes;
+    for (const Polyline2& line : planar) {
+      mapped.push_back(curves::map_polyline(line, curves::cylinder_map(), options));
+      const size_t n = line.points.size();
+      auto unrolled = [&](size_t i) { return Vec2d{M_PI * line.points[i % n].x, line.points[i % n].y}; };
+      for (size_t i = 0; i < n; ++i) {
+        std::vector<Vec2d> disk;
+        for (int k = 0; k < 128; ++k)
+          disk.push_back(unrolled(i) + Vec2d{r * std::cos(2 * M_PI * k / 128), r * std::sin(2 * M_PI * k / 128)});
+        strokes.push_back(disk);
+        if (i + 1 == n && !line.closed) break;
+        const Vec2d a = unrolled(i), b = unrolled(i + 1), t = (b - a) * (1 / std::hypot(b.x - a.x, b.y - a.y));
+        const Vec2d side{-t.y * r, t.x * r};
+        strokes.push_back({a - side, b - side, b + side, a + side});
+      }
+    }
+    const double planar_rate = curves::convex_union_area(strokes, {-M_PI - 1, -2}, {M_PI + 1, 2}) / (4 * M_PI);
+    const curves::SurfaceCoverage c = whole_coverage(curves::cylinder_map(), mapped, r, 2000);
+    EXPECT_NEAR(c.area, 4 * M_PI, 1e-4);
+    EXPECT_NEAR(c.fill_rate(), planar_rate, 0.002 * planar_rate) << "order " << order;
+    EXPECT_GT(planar_rate, 0.05);
+  }
+}
+
 TEST(FillRate, SuperpositionAgainstSampling) {
   const auto hilbert = curves::polylines_of(curves::superposition(CurveKind::kHilbert, {1, 2, 3, 4}));
   const double exact = curves::fill_rate_exact(hilbert, 0.02);

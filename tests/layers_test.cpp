@@ -9,7 +9,10 @@
 #include <zlib.h>
 
 #include <cmath>
+#include <condition_variable>
 #include <cstring>
+#include <mutex>
+#include <thread>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -463,6 +466,114 @@ TEST(Slice, TheBudgetPicksTheSlabsAndNothingIsLeftBehind) {
   for (const auto& entry : fs::directory_iterator(dir.path())) {
     const std::string name = entry.path().filename().string();
     EXPECT_TRUE(name == "whole.zip" || name == "slabs.zip" || name == "folder") << name;
+  }
+}
+
+// Processes of one job played by threads: every exchange waits for all of them (a barrier per call).
+class ThreadRanks : public SliceRanks {
+ public:
+  struct Shared {
+    explicit Shared(int n) : slots(size_t(n)) {}
+    std::mutex mutex;
+    std::condition_variable changed;
+    std::vector<std::string> slots, result;
+    int arrived = 0;
+    uint64_t round = 0;
+  };
+  ThreadRanks(Shared& shared, int rank) : shared_(shared), rank_(rank) {}
+  int rank() const override { return rank_; }
+  int size() const override { return int(shared_.slots.size()); }
+  double min(double value) override {
+    double out = value;
+    for (const std::string& v : all(std::to_string(value))) out = std::min(out, std::stod(v));
+    return out;
+  }
+  int64_t max(int64_t value) override {
+    int64_t out = value;
+    for (const std::string& v : all(std::to_string(value))) out = std::max<int64_t>(out, std::stoll(v));
+    return out;
+  }
+  std::vector<std::string> gather(const std::string& bytes) override {
+    std::vector<std::string> every = all(bytes);
+    return rank_ == 0 ? every : std::vector<std::string>();
+  }
+
+ private:
+  std::vector<std::string> all(const std::string& mine) {
+    std::unique_lock<std::mutex> lock(shared_.mutex);
+    const uint64_t round = shared_.round;
+    shared_.slots[size_t(rank_)] = mine;
+    if (++shared_.arrived == size()) {
+      shared_.result = shared_.slots;
+      shared_.arrived = 0;
+      ++shared_.round;
+      shared_.changed.notify_all();
+    } else {
+      shared_.changed.wait(lock, [&] { return shared_.round != round; });
+    }
+    return shared_.result;
+  }
+  Shared& shared_;
+  int rank_;
+};
+
+// A sink that asks to stop (a process interrupted by its user).
+struct StopAtOnce : ProgressSink {
+  void begin(const std::string&, uint64_t) override {}
+  void advance(uint64_t) override {}
+  void end() override {}
+  bool cancelled() const override { return true; }
+};
+
+TEST(Slice, ProcessesShareTheSlabsAndFailTogether) {
+  TempDir dir;
+  const std::string recipe = std::string(LACUNA_SOURCE_DIR) + "/samples/hollow_sphere.json";
+  SliceOptions alone;
+  alone.layer_mm = 0.4;
+  ASSERT_TRUE(slice_recipe(recipe, (dir / "alone.zip").string(), alone).valid);
+  // Three processes (threads here; `mpirun` in tests/python/test_mpi.py): the same bytes.
+  {
+    ThreadRanks::Shared shared(3);
+    std::vector<SliceReport> reports(3);
+    std::vector<std::thread> threads;
+    for (int r = 0; r < 3; ++r)
+      threads.emplace_back([&, r] {
+        ThreadRanks ranks(shared, r);
+        SliceOptions options = alone;
+        options.ranks = &ranks;
+        reports[size_t(r)] = slice_recipe(recipe, (dir / "ranks.zip").string(), options);
+      });
+    for (std::thread& t : threads) t.join();
+    for (const SliceReport& report : reports) EXPECT_TRUE(report.valid);
+    EXPECT_EQ(reports[0].slabs, 3u);
+    EXPECT_EQ(reports[0].layers.size(), 50u);
+    EXPECT_EQ(test::read_file(dir / "alone.zip"), test::read_file(dir / "ranks.zip"));
+  }
+  // Process 1 is stopped while it evaluates its slabs: it ends with its own error, the others with one
+  // naming it, and nothing is written.
+  ThreadRanks::Shared shared(2);
+  std::vector<std::string> errors(2);
+  std::vector<std::thread> threads;
+  StopAtOnce stop;
+  for (int r = 0; r < 2; ++r)
+    threads.emplace_back([&, r] {
+      ThreadRanks ranks(shared, r);
+      SliceOptions options = alone;
+      options.ranks = &ranks;
+      if (r == 1) options.run.progress = &stop;
+      try {
+        slice_recipe(recipe, (dir / "failed.zip").string(), options);
+      } catch (const Cancelled& e) {
+        errors[size_t(r)] = e.what();
+      }
+    });
+  for (std::thread& t : threads) t.join();
+  EXPECT_NE(errors[0].find("process 1 of 2 failed"), std::string::npos) << errors[0];
+  EXPECT_FALSE(errors[1].empty());
+  EXPECT_EQ(errors[1].find("process 1 of 2"), std::string::npos) << errors[1];
+  for (const auto& entry : fs::directory_iterator(dir.path())) {
+    const std::string name = entry.path().filename().string();
+    EXPECT_TRUE(name == "alone.zip" || name == "ranks.zip") << name;
   }
 }
 

@@ -434,7 +434,7 @@ int run_app(int argc, char** argv) {
       ->check(number_in(0, 1e9, true));
   slice->add_option("--slab-mm", slice_args.options.slab_mm,
                     "Evaluate slab by slab, this high in mm (default: the whole part when it fits the budget;\n"
-                    "under mpirun -np K, at least K slabs, split over the ranks)")
+                    "under mpirun -np K, the slabs are split over the ranks, K of them when the whole part fits)")
       ->check(non_negative_number());
   add_common(slice, flags);
   std::function<int()> cifs_command = add_cifs_commands(app);

@@ -22,6 +22,8 @@ struct CurveArgs {
   std::string surface = "plane";
   double tolerance = 0.01;
   double width = 0.02;
+  int samples = 0;
+  bool surface_given = false;
   bool json = false;
   bool csv = false;
 };
@@ -84,7 +86,32 @@ int curve_points(const CurveArgs& args) {
   return kExitOk;
 }
 
+// On a surface: the tubes' footprint over the surface's area (curve_surface_fill_rate).
+int curve_surface_fill_rate(const CurveArgs& args) {
+  if (!(args.width > 0)) throw InvalidInput("--width: expected a positive tube diameter");
+  const SurfaceFillRate r = lacuna::curve_surface_fill_rate(kind_of(args.kind), parse_orders(args.orders), args.width,
+                                                            surface_of(args.surface), args.samples, args.tolerance);
+  if (args.json) {
+    std::cout << nlohmann::json{{"kind", args.kind},         {"surface", args.surface},
+                                {"orders", r.orders},        {"width", args.width},
+                                {"samples", r.samples},      {"tolerance", args.tolerance},
+                                {"area", r.area},            {"covered_area", r.covered_area},
+                                {"length", r.length},        {"fill_rate", r.fill_rate},
+                                {"fill_rate_simple", r.fill_rate_simple}}
+                     .dump(2)
+              << "\n";
+    return kExitOk;
+  }
+  std::printf("%s orders %s on the %s, tubes of width %g: length %.6g, surface area %.6g\n", args.kind.c_str(),
+              args.orders.c_str(), args.surface.c_str(), args.width, r.length, r.area);
+  std::printf("fill rate (the tubes' footprint, %d x %d samples%s): %.4f %%\n", r.samples, r.samples,
+              args.surface == "cube" ? " per face" : "", 100 * r.fill_rate);
+  std::printf("fill rate (length x width / area): %.4f %%\n", 100 * r.fill_rate_simple);
+  return kExitOk;
+}
+
 int curve_fill_rate(const CurveArgs& args) {
+  if (args.surface_given) return curve_surface_fill_rate(args);
   if (!(args.width > 0)) throw InvalidInput("--width: expected a positive stroke width (the square has side 2)");
   const CurveFillRate r = lacuna::curve_fill_rate(kind_of(args.kind), parse_orders(args.orders), args.width);
   const uint64_t segments = r.segments;
@@ -120,10 +147,21 @@ std::function<int()> add_curve_commands(CLI::App& app) {
   points->add_option("--tolerance", args->tolerance, "Chord tolerance on a surface (units of the square)")
       ->check(positive_number());
   points->add_flag("--csv", args->csv, "Print order,polyline,x,y,z lines");
-  fill->add_option("--width", args->width, "Stroke width (the square has side 2)")->check(positive_number());
+  fill->add_option("--width", args->width, "Stroke width (the square has side 2); on a surface the tubes' diameter")
+      ->check(positive_number());
+  fill->add_option("--surface", args->surface,
+                   "plane, sphere, cylinder, torus, cone or cube: the fraction of the (unit) surface's area the tubes\n"
+                   "along the curves drawn on it cover (without it: the square's strokes, exactly)");
+  fill->add_option("--samples", args->samples, "On a surface: integration cells per side (default: 8 across a tube)")
+      ->check(CLI::Range(16, 20000));
+  fill->add_option("--tolerance", args->tolerance, "On a surface: chord tolerance of the drawn curves")
+      ->check(positive_number());
   return [=]() -> int {
     if (*points) return curve_points(*args);
-    if (*fill) return curve_fill_rate(*args);
+    if (*fill) {
+      args->surface_given = fill->count("--surface") > 0;
+      return curve_fill_rate(*args);
+    }
     return -1;
   };
 }

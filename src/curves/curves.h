@@ -134,6 +134,40 @@ SurfaceMap cube_face_map(int face);
 // central differences (one-sided at the square's border); zero where the map is degenerate.
 Vec3d surface_normal(const SurfaceMap& map, double X, double Y);
 
+// The footprint of tubes of `radius` along polylines: the points within `radius` (3D distance) of a
+// segment, found through a bucket grid of the segments' boxes (at most 256 cells a side). Throws
+// InvalidInput unless radius > 0.
+class TubeFootprint {
+ public:
+  TubeFootprint(const std::vector<Polyline3>& lines, double radius);
+  bool covers(const Vec3d& p) const;
+
+ private:
+  std::vector<std::pair<Vec3d, Vec3d>> segments_;
+  std::vector<std::vector<uint32_t>> buckets_;
+  Vec3d lo_, hi_;
+  double cell_ = 0, radius_ = 0;
+  int dims_[3] = {1, 1, 1};
+  int cell_of(double v, int k) const;
+};
+
+// What the footprint covers of a surface (the image of the square), integrated in parameter space: the
+// square's n x n cells, one point in each at a fixed pseudo-random place (stratified, so that the samples
+// do not alias with the curves' lattice), weighted by the map's area element there (central differences
+// of its points), covered when its surface point is in the footprint. This sums the rows
+// [row_begin, row_end) (callers split the rows over threads and add them in order). Exact in the limit
+// of fine cells; where the map is an isometry up to scale (the cylinder, the cube's faces) it is the
+// planar rate of the unrolled strokes with round ends. Throws InvalidInput unless 16 <= n <= 20000 and
+// for a map without points.
+struct SurfaceCoverage {
+  double area = 0;          // of the surface
+  double covered_area = 0;  // of the tubes' footprint on it
+  uint64_t samples = 0;
+  double fill_rate() const { return area > 0 ? covered_area / area : 0; }
+};
+SurfaceCoverage surface_coverage(const SurfaceMap& map, const TubeFootprint& footprint, int n, int row_begin,
+                                 int row_end);
+
 struct MapOptions {
   double scale = 1;            // multiplies the surface's points: millimetres per unit
   double offset_mm = 0;        // along the unit normal after scaling, positive outwards

@@ -129,7 +129,9 @@ MemoryNeed estimate(const Recipe& recipe, const Plan& plan, const std::map<std::
                            fixed(2 * half_thickness, 6) + " mm thick)");
       if (!offset || offset->distance_mm < 0) d = std::min(d, half_thickness);
       total.mesh_bytes = std::max(total.mesh_bytes, estimate_from_voxels(first.voxels, vopt).surface_bytes);
-      work.half_band_voxels += d / vopt.voxel_size_mm;
+      // The band grows by the distance on one side only (outwards for a growing offset, inwards
+      // otherwise): as much as half of it on each.
+      work.half_band_voxels += 0.5 * d / vopt.voxel_size_mm;
       // The band as wide as the distance is around the first operand only (an infill's hull).
       MemoryEstimate wide = estimate_from_voxels(band_voxels(first.area, o.box, work), work);
       total.grid_bytes += wide.grid_bytes;

@@ -1,5 +1,7 @@
 #include "pipeline/generators.h"
 
+#include <tbb/parallel_for.h>
+
 #include <cmath>
 #include <functional>
 #include <nlohmann/json.hpp>
@@ -179,6 +181,49 @@ CurveFillRate curve_fill_rate(curves::CurveKind kind, const std::vector<int>& or
   }
   r.fill_rate = curves::fill_rate_exact(lines, width);
   r.fill_rate_simple = curves::fill_rate_estimate(lines, width);
+  return r;
+}
+
+SurfaceFillRate curve_surface_fill_rate(curves::CurveKind kind, const std::vector<int>& orders, double width,
+                                        CurveSurface surface, int samples, double tolerance) {
+  if (!(width > 0) || !std::isfinite(width)) throw InvalidInput("expected a positive tube width");
+  if (samples != 0 && (samples < 16 || samples > 20000))
+    throw InvalidInput("samples: expected 16 .. 20000 per side, or 0 for eight cells across a tube");
+  const int n = samples ? samples : int(std::clamp(std::ceil(16 / width), 256.0, 20000.0));
+  SurfaceFillRate r;
+  r.samples = n;
+  std::vector<curves::Polyline3> lines;
+  for (const DrawnCurve& c : curve_points(kind, false, orders, surface, tolerance)) {
+    if (r.orders.empty() || r.orders.back() != c.order) r.orders.push_back(c.order);
+    for (size_t i = 0; i + 1 < c.points.size() + (c.closed ? 1 : 0); ++i)
+      r.length += norm(c.points[(i + 1) % c.points.size()] - c.points[i]);
+    lines.push_back(curves::Polyline3{c.points, c.closed});
+  }
+  const curves::TubeFootprint footprint(lines, width / 2);
+  std::vector<curves::SurfaceMap> maps;
+  switch (surface) {
+    case CurveSurface::kPlane: {
+      curves::SurfaceMap plane;
+      plane.name = "plane";
+      plane.point = [](double X, double Y) { return Vec3d{X, Y, 0}; };
+      maps.push_back(plane);
+      break;
+    }
+    case CurveSurface::kSphere: maps.push_back(curves::sphere_map()); break;
+    case CurveSurface::kCylinder: maps.push_back(curves::cylinder_map()); break;
+    case CurveSurface::kTorus: maps.push_back(curves::torus_map()); break;
+    case CurveSurface::kCone: maps.push_back(curves::cone_map()); break;
+    case CurveSurface::kCube:
+      for (int face = 0; face < 6; ++face) maps.push_back(curves::cube_face_map(face));
+      break;
+  }
+  for (const curves::SurfaceMap& map : maps) {
+    std::vector<curves::SurfaceCoverage> rows(static_cast<size_t>(n));
+    tbb::parallel_for(0, n, [&](int j) { rows[size_t(j)] = curves::surface_coverage(map, footprint, n, j, j + 1); });
+    for (const curves::SurfaceCoverage& row : rows) r.area += row.area, r.covered_area += row.covered_area;
+  }
+  r.fill_rate = r.area > 0 ? r.covered_area / r.area : 0;
+  r.fill_rate_simple = r.area > 0 ? r.length * width / r.area : 0;
   return r;
 }
 

@@ -81,6 +81,24 @@ struct CurveFillRate {
 // Throws InvalidInput unless width > 0.
 CurveFillRate curve_fill_rate(curves::CurveKind kind, const std::vector<int>& orders, double width);
 
+// The fraction of a unit surface's area that tubes of diameter `width` along the curves drawn on it
+// (curve_points(), chords within `tolerance`) cover: curves::surface_coverage on samples x samples
+// cells of the square (each of the cube's six faces), rows in parallel, summed in order (identical for
+// any thread count); samples 0: eight cells across a tube.
+struct SurfaceFillRate {
+  std::vector<int> orders;
+  double area = 0;              // of the surface
+  double covered_area = 0;      // of the tubes' footprint on it
+  double fill_rate = 0;         // covered_area / area
+  double length = 0;            // of the mapped polylines
+  double fill_rate_simple = 0;  // length x width / area
+  int samples = 0;              // per side of the square (per face)
+};
+
+// Throws InvalidInput unless width > 0 and samples is 0 or 16 .. 20000, and as curve_points().
+SurfaceFillRate curve_surface_fill_rate(curves::CurveKind kind, const std::vector<int>& orders, double width,
+                                        CurveSurface surface, int samples, double tolerance);
+
 // A fractal Voronoi level's cell measures per colour and, with scaled children, its walls.
 struct VoronoiCells {
   voronoi::Level level;

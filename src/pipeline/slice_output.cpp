@@ -117,6 +117,17 @@ void in_every_rank(SliceRanks* ranks, Step&& step) {
   }
 }
 
+// A timer's stages, each started once per slab, added up by name in the order they first ran.
+std::vector<std::pair<std::string, double>> stage_totals(const StageTimer& timer) {
+  std::vector<std::pair<std::string, double>> totals;
+  for (const auto& [name, seconds] : timer.seconds()) {
+    auto same = std::find_if(totals.begin(), totals.end(), [&](const auto& t) { return t.first == name; });
+    if (same == totals.end()) totals.emplace_back(name, seconds);
+    else same->second += seconds;
+  }
+  return totals;
+}
+
 // Length-prefixed texts in one string (what processes hand each other).
 void append_text(std::string& out, const std::string& text) {
   const uint64_t n = text.size();
@@ -462,9 +473,13 @@ std::string layers_file(const SlicedLayers& sliced, const std::string& where) {
 }
 
 SliceReport slice_recipe(const std::string& recipe_path, const std::string& output, const SliceOptions& options) {
+  layer_format_from_path(output, options.binary);  // a bad output is refused before the recipe is read
+  return slice_recipe(load_recipe(recipe_path), output, options);
+}
+
+SliceReport slice_recipe(Recipe recipe, const std::string& output, const SliceOptions& options) {
   LayerSettings settings;
   settings.format = layer_format_from_path(output, options.binary);
-  Recipe recipe = load_recipe(recipe_path);
   if (options.run.voxel_size_mm > 0) recipe.voxel_size_mm = options.run.voxel_size_mm;
   std::optional<tbb::global_control> threads;
   if (options.run.threads > 0)
@@ -478,67 +493,78 @@ SliceReport slice_recipe(const std::string& recipe_path, const std::string& outp
 
   StageTimer timer;
   timer.start("build");
+  // A job over several processes: each takes a block of the slabs (split into as many as there are
+  // processes, when the part is that many leaves high, if the whole would fit one). They agree on
+  // the budget (the least of theirs), so that they cut the same slabs.
+  SliceRanks* ranks = options.ranks && options.ranks->size() > 1 ? options.ranks : nullptr;
+  const int rank_count = ranks ? ranks->size() : 1, me = ranks ? ranks->rank() : 0;
+  uint64_t budget = options.run.max_memory_bytes ? options.run.max_memory_bytes : available_memory_bytes() / 2;
+  if (ranks) budget = uint64_t(ranks->min(double(budget)));
   Recipe only = recipe_for_object(recipe, settings.name);
   only.outputs.front().layers = RecipeOutput::Layers{};  // cut from the level set: no mesh to reserve memory for
-  const uint64_t budget = options.run.max_memory_bytes ? options.run.max_memory_bytes : available_memory_bytes() / 2;
-  const BuiltInputs inputs = build_inputs(only, budget);
-  const Plan p = plan(only);
   const std::string what = recipe.file + ": \"" + settings.name + "\"";
-  const MemoryEstimator estimator(only, p, inputs);
-  const ObjectExtent extent = estimator.extents().at(settings.name);
-  const double h = only.voxel_size_mm, band = h * only.band_voxels;
-
+  if (options.slab_mm < 0 || !std::isfinite(options.slab_mm))
+    throw InvalidInput(what + ": slab_mm: expected a positive height in mm, or 0 to choose one");
+  const double h = only.voxel_size_mm, band = h * only.band_voxels, leaf = 8 * h;
+  std::optional<BuiltInputs> inputs;
+  std::optional<Plan> p;
+  std::optional<MemoryEstimator> estimator;
+  std::optional<OutputFolder> folder;
+  ObjectExtent extent;
   // Slabs of whole leaves (8 voxels) stacked from below the box; each is evaluated with a halo on
   // both sides deep enough that the object there equals the whole run's, and a band and a voxel
   // more for the layers' interpolation and the lowest point's search.
-  const double leaf = 8 * h;
-  const double halo = std::ceil((extent.halo_mm + band + 2 * h) / leaf) * leaf;
-  const double bottom = std::floor((extent.box.min.z - band - h) / leaf) * leaf;
-  const double top = extent.box.max.z + band + 2 * h;
-  const double whole = std::ceil((top - bottom) / leaf) * leaf;
-  auto slabs_of = [&](double height) {
-    std::vector<ZSlab> slabs;
-    for (double lo = bottom; lo < top; lo += height) slabs.push_back({lo - halo, lo + height + halo});
-    return slabs;
-  };
-  if (options.slab_mm < 0 || !std::isfinite(options.slab_mm))
-    throw InvalidInput(what + ": slab_mm: expected a positive height in mm, or 0 to choose one");
-  double slab_height = 0;  // 0: the whole part at once
-  if (options.slab_mm > 0) {
-    slab_height = std::ceil(options.slab_mm / leaf - 1e-9) * leaf;
-  } else if (estimator.bytes() > budget) {
-    // The highest slabs that fit (in leaves): the estimate grows with their height.
-    size_t lo = 1, hi = size_t(std::ceil(whole / leaf));
-    if (estimator.bytes(slabs_of(leaf)) > budget)
-      throw ResourceLimit(what + ": even slabs of " + detail::fixed(leaf, 4) + " mm (with a halo of " +
-                          detail::fixed(halo, 4) + " mm below and above) need more than the budget of " +
-                          format_bytes(budget) + "; use a larger voxel size or more memory");
-    while (hi - lo > 1) {
-      const size_t mid = (lo + hi) / 2;
-      (estimator.bytes(slabs_of(double(mid) * leaf)) <= budget ? lo : hi) = mid;
+  double halo = 0, bottom = 0, top = 0, whole = 0, slab_height = 0;  // slab_height 0: the whole part at once
+  in_every_rank(ranks, [&] {
+    inputs.emplace(build_inputs(only, budget));
+    p.emplace(plan(only));
+    estimator.emplace(only, *p, *inputs);
+    extent = estimator->extents().at(settings.name);
+    halo = std::ceil((extent.halo_mm + band + 2 * h) / leaf) * leaf;
+    bottom = std::floor((extent.box.min.z - band - h) / leaf) * leaf;
+    top = extent.box.max.z + band + 2 * h;
+    whole = std::ceil((top - bottom) / leaf) * leaf;
+    auto slabs_of = [&](double height) {
+      std::vector<ZSlab> slabs;
+      for (double lo = bottom; lo < top; lo += height) slabs.push_back({lo - halo, lo + height + halo});
+      return slabs;
+    };
+    if (options.slab_mm > 0) {
+      slab_height = std::ceil(options.slab_mm / leaf - 1e-9) * leaf;
+    } else if (estimator->bytes() > budget) {
+      // The highest slabs that fit (in leaves): the estimate grows with their height.
+      size_t lo = 1, hi = size_t(std::ceil(whole / leaf));
+      if (estimator->bytes(slabs_of(leaf)) > budget)
+        throw ResourceLimit(what + ": even slabs of " + detail::fixed(leaf, 4) + " mm (with a halo of " +
+                            detail::fixed(halo, 4) + " mm below and above) need more than the budget of " +
+                            format_bytes(budget) + "; use a larger voxel size or more memory");
+      while (hi - lo > 1) {
+        const size_t mid = (lo + hi) / 2;
+        (estimator->bytes(slabs_of(double(mid) * leaf)) <= budget ? lo : hi) = mid;
+      }
+      slab_height = double(lo) * leaf;
     }
-    slab_height = double(lo) * leaf;
-  }
-
-  // A job over several processes: each takes a block of the slabs (split into as many as there are
-  // processes when the whole part would fit one).
-  SliceRanks* ranks = options.ranks && options.ranks->size() > 1 ? options.ranks : nullptr;
-  const int rank_count = ranks ? ranks->size() : 1, me = ranks ? ranks->rank() : 0;
+    if (settings.format == LayerFormat::kPng && me == 0) folder.emplace(output);
+  });
   if (ranks && (slab_height == 0 || slab_height * rank_count > whole))
     slab_height = std::ceil(whole / leaf / rank_count) * leaf;
   if (slab_height >= whole) slab_height = 0;
-  const std::vector<ZSlab> slabs = slab_height > 0 ? slabs_of(slab_height) : std::vector<ZSlab>{{bottom, bottom + whole}};
+  // Slab i's own part is [cuts[i], cuts[i + 1]), computed once so that neighbours agree to the bit;
+  // the first reaches down and the last up without end (their layers are theirs).
+  std::vector<double> cuts = {bottom};
+  while (slab_height > 0 && cuts.back() < top) cuts.push_back(bottom + double(cuts.size()) * slab_height);
+  if (slab_height == 0) cuts.push_back(bottom + whole);
+  std::vector<ZSlab> slabs;
+  for (size_t i = 0; i + 1 < cuts.size(); ++i) slabs.push_back({cuts[i] - halo, cuts[i + 1] + halo});
   const size_t first_slab = slabs.size() * size_t(me) / size_t(rank_count);
   const size_t end_slab = slabs.size() * size_t(me + 1) / size_t(rank_count);
-  auto slab_lo = [&](size_t i) { return slab_height > 0 ? slabs[i].lo_mm + halo : -std::numeric_limits<double>::infinity(); };
-  auto slab_hi = [&](size_t i) { return slab_height > 0 ? slabs[i].hi_mm - halo : std::numeric_limits<double>::infinity(); };
+  auto slab_lo = [&](size_t i) { return i == 0 ? -std::numeric_limits<double>::infinity() : cuts[i]; };
+  auto slab_hi = [&](size_t i) { return i + 1 == slabs.size() ? std::numeric_limits<double>::infinity() : cuts[i + 1]; };
 
   LayerSlicer slicer(settings, h, what, budget);
   // Images go to disk as they are made, hidden beside the output, so memory holds a slab and the
   // layers in progress only; they become the output when every layer passed.
   const bool images = settings.format != LayerFormat::kCli && settings.format != LayerFormat::kCliBinary;
-  std::optional<OutputFolder> folder;
-  if (settings.format == LayerFormat::kPng && me == 0) folder.emplace(output);
   const fs::path spool_dir = fs::path(output).parent_path();
   OutputTransaction spool;
   std::vector<std::string> spooled;
@@ -553,20 +579,23 @@ SliceReport slice_recipe(const std::string& recipe_path, const std::string& outp
                                                       layer_file_name(k))).string());
       }
       write_whole_file(path, png);
-      // The archive entry takes the file's mode: the same as an entry made in memory.
-      fs::permissions(path, fs::perms(0666));
+      // An archive's entry takes the file's mode: the same as an entry made in memory. (A folder's
+      // layers keep the mode the process makes files with.)
+      std::error_code error;
+      if (settings.format != LayerFormat::kPng) fs::permissions(path, fs::perms(0666), error);
+      if (error) throw IoError(output + ": cannot set up a layer's image: " + error.message());
     });
   uint64_t estimate = 0;
-  std::map<std::string, Volume> converted_meshes;  // imported meshes, converted once
+  std::map<std::string, Volume> converted_meshes;  // a streamed run's imported meshes, converted once
   auto evaluate_slab = [&](size_t i) {
     throw_if_cancelled(sink);
     EvaluateOptions evaluate_options;
     evaluate_options.max_memory_bytes = budget;
     evaluate_options.slab = slab_height > 0 ? &slabs[i] : nullptr;
-    evaluate_options.converted_meshes = &converted_meshes;
-    evaluate_options.estimator = &estimator;
+    evaluate_options.converted_meshes = slab_height > 0 ? &converted_meshes : nullptr;
+    evaluate_options.estimator = &*estimator;
     timer.start("evaluate");
-    Evaluation evaluation = evaluate(only, p, inputs, evaluate_options);
+    Evaluation evaluation = evaluate(only, *p, *inputs, evaluate_options);
     estimate = std::max(estimate, evaluation.memory_estimate_bytes);
     Volume volume = evaluation.take(settings.name);
     timer.start("slice");
@@ -582,7 +611,7 @@ SliceReport slice_recipe(const std::string& recipe_path, const std::string& outp
   in_every_rank(ranks, [&] {
     for (size_t i = first_slab; i < end_slab; ++i) {
       Volume volume = evaluate_slab(i);
-      const Box3 found = slab_height > 0 ? solid_box(volume, slab_lo(i), slab_hi(i) + band + h) : solid_box(volume);
+      const Box3 found = solid_box(volume, slab_lo(i), slab_hi(i) + band + h);
       if (!found.empty()) {
         lowest = found.min.z;
         kept_slab = i;
@@ -599,19 +628,24 @@ SliceReport slice_recipe(const std::string& recipe_path, const std::string& outp
   slicer.start(extent.box, lowest);
 
   // 2. Every layer cut from the slab its plane lies in (the first slab holding solid also cuts those
-  // below it). A later process first goes back over the slabs it dropped.
+  // below it). A later process whose first slab held no solid goes back over its slabs (one slab in
+  // memory at a time: the one it kept is dropped).
   in_every_rank(ranks, [&] {
     // Nothing of the solid below: its layers are the next process's.
     if (first_slab == end_slab || me < int(first_rank)) return;
     if (me > int(first_rank)) {
       slicer.skip_to(slab_lo(first_slab));
-      for (size_t i = first_slab; i < kept_slab; ++i) slicer.sample(evaluate_slab(i), slab_hi(i));
+      if (kept_slab != first_slab) {
+        kept = Volume();
+        for (size_t i = first_slab; i < end_slab; ++i) slicer.sample(evaluate_slab(i), slab_hi(i));
+        return;
+      }
     }
-    if (kept_slab == end_slab) return;
     slicer.sample(kept, slab_hi(kept_slab));
     kept = Volume();
     for (size_t i = kept_slab + 1; i < end_slab; ++i) slicer.sample(evaluate_slab(i), slab_hi(i));
   });
+  converted_meshes.clear();
 
   // 3. The first process gathers every layer (figures, problems, contours, where the images are).
   if (ranks) {
@@ -622,6 +656,16 @@ SliceReport slice_recipe(const std::string& recipe_path, const std::string& outp
         if (!spooled[k].empty()) append_text(mine, std::to_string(k) + "\n" + spooled[k]);
       gathered = ranks->gather(mine);
     });
+    in_every_rank(ranks, [&] {
+      for (size_t r = 1; r < gathered.size(); ++r) {
+        for (const std::string& entry : slicer.unpack(gathered[r])) {
+          const size_t split = entry.find('\n');
+          const size_t k = std::stoul(entry.substr(0, split));
+          if (spooled.size() <= k) spooled.resize(k + 1);
+          spooled[k] = entry.substr(split + 1);
+        }
+      }
+    });
     if (me != 0) {
       // The first process writes; the images stay until it has.
       SliceReport report;
@@ -630,17 +674,8 @@ SliceReport slice_recipe(const std::string& recipe_path, const std::string& outp
       in_every_rank(ranks, [] {});
       report.valid = ranks->max(0) == 0;
       timer.stop();
-      report.stage_seconds = timer.seconds();
+      report.stage_seconds = stage_totals(timer);
       return report;
-    }
-    for (size_t r = 1; r < gathered.size(); ++r) {
-      const std::vector<std::string> paths = slicer.unpack(gathered[r]);
-      for (const std::string& entry : paths) {
-        const size_t split = entry.find('\n');
-        const size_t k = std::stoul(entry.substr(0, split));
-        if (spooled.size() <= k) spooled.resize(k + 1);
-        spooled[k] = entry.substr(split + 1);
-      }
     }
   }
   SliceReport report;
@@ -659,8 +694,11 @@ SliceReport slice_recipe(const std::string& recipe_path, const std::string& outp
       if (settings.format == LayerFormat::kPng) {
         for (size_t k = 0; k < sliced.stack.layers; ++k) {
           const std::string staged = transaction.stage((fs::path(output) / layer_file_name(k)).string());
-          fs::rename(spooled[k], staged);
-          sliced.report.bytes += fs::file_size(staged);
+          std::error_code error;
+          fs::rename(spooled[k], staged, error);
+          const uint64_t size = error ? 0 : uint64_t(fs::file_size(staged, error));
+          if (error) throw IoError(output + ": cannot move " + layer_file_name(k) + " into place: " + error.message());
+          sliced.report.bytes += size;
         }
         const std::string manifest = layer_manifest(sliced.stack);
         write_whole_file(transaction.stage((fs::path(output) / "manifest.json").string()), manifest);
@@ -671,7 +709,9 @@ SliceReport slice_recipe(const std::string& recipe_path, const std::string& outp
         std::vector<std::string> texts;
         const std::string staged = transaction.stage(output);
         write_zip_archive(layer_archive_entries(sliced, texts, &spooled), staged, output);
-        sliced.report.bytes = fs::file_size(staged);
+        std::error_code error;
+        sliced.report.bytes = uint64_t(fs::file_size(staged, error));
+        if (error) throw IoError(output + ": cannot read the archive's size back: " + error.message());
         transaction.commit();
       } else {
         const std::string bytes = layers_file(sliced, output);
@@ -685,7 +725,7 @@ SliceReport slice_recipe(const std::string& recipe_path, const std::string& outp
   if (ranks) ranks->max(report.valid ? 0 : 1);
   spool.rollback();
   timer.stop();
-  report.stage_seconds = timer.seconds();
+  report.stage_seconds = stage_totals(timer);
   return report;
 }
 

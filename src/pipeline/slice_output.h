@@ -14,6 +14,7 @@
 #include "export/zip_archive.h"
 #include "layers/layers.h"
 #include "pipeline/pipeline.h"
+#include "recipe/recipe.h"
 #include "solids/volume.h"
 #include "util/progress.h"
 
@@ -160,6 +161,8 @@ std::vector<ZipEntry> layer_archive_entries(const SlicedLayers& sliced, std::vec
 // ResourceLimit, Cancelled) and InvalidInput for bad sizes or an empty object; when a layer fails its
 // checks the report is not valid and nothing is written.
 SliceReport slice_recipe(const std::string& recipe_path, const std::string& output, const SliceOptions& options);
+// The same for a recipe already loaded (the Python module's).
+SliceReport slice_recipe(Recipe recipe, const std::string& output, const SliceOptions& options);
 
 // The report as JSON (per layer figures under "layers").
 nlohmann::json to_json(const SliceReport& report);

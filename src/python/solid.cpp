@@ -15,6 +15,7 @@
 #include "export/mesh_io.h"
 #include "pipeline/mesh_object.h"
 #include "pipeline/pipeline.h"
+#include "pipeline/slice_output.h"
 #include "python/convert.h"
 #include "python/objects.h"
 #include "recipe/json_fields.h"
@@ -587,6 +588,50 @@ void add_solids(py::module_& m) {
       "None: half the machine's), threads the worker threads (None: every core). Returns a RunResult (report dict and "
       "meshes); raises CheckFailedError (with .report) when an output fails its checks, ResourceLimitError beyond "
       "the budget, ValueError for a bad recipe; Ctrl-C cancels the run and leaves nothing behind.");
+
+  m.def(
+      "slice",
+      [](const py::handle& recipe, const py::object& output, const std::string& object, const py::object& layer_mm,
+         const py::object& pixel_mm, const py::object& tolerance_mm, bool binary, const py::object& slab_mm,
+         const py::object& voxel_size_mm, const py::object& max_memory_gb, const py::object& threads) {
+        Recipe r = recipe_of(recipe);
+        SliceOptions options;
+        options.object = object;
+        auto length = [](const py::object& v, const char* key, double none) {
+          if (v.is_none()) return none;
+          const double x = v.cast<double>();
+          if (!(x >= 0) || !std::isfinite(x)) throw InvalidInput(std::string(key) + ": expected a length in mm, at least 0");
+          return x;
+        };
+        options.layer_mm = length(layer_mm, "layer_mm", 0);
+        options.pixel_mm = length(pixel_mm, "pixel_mm", 0);
+        options.tolerance_mm = length(tolerance_mm, "tolerance_mm", -1);
+        options.binary = binary;
+        options.slab_mm = length(slab_mm, "slab_mm", 0);
+        options.run.voxel_size_mm = length(voxel_size_mm, "voxel_size_mm", 0);
+        const ObjectOptions o = object_options(py::none(), max_memory_gb, threads);
+        options.run.max_memory_bytes = o.max_memory_bytes;
+        options.run.threads = o.threads;
+        const std::string path = path_of(output), label = r.file;
+        const SliceReport result = released([&] { return slice_recipe(std::move(r), path, options); });
+        const nlohmann::json report = to_json(result);
+        if (!result.valid) {
+          std::string message = label + ": layers failed their checks; nothing was written";
+          for (const auto& problem : result.problems) message += "\n  " + problem;
+          raise(errors().check_failed, message, from_json(report));
+        }
+        return from_json(report);
+      },
+      py::arg("recipe"), py::arg("output"), py::arg("object") = "", py::arg("layer_mm") = py::none(),
+      py::arg("pixel_mm") = py::none(), py::arg("tolerance_mm") = py::none(), py::arg("binary") = false,
+      py::arg("slab_mm") = py::none(), py::arg("voxel_size_mm") = py::none(), py::arg("max_memory_gb") = py::none(),
+      py::arg("threads") = py::none(),
+      "Cuts one object of a recipe (a path, JSON text or a dict; default: its first output's) into layers as "
+      "`lacuna slice` does, with no mesh: output a folder (PNG layers and manifest.json), FILE.zip, FILE.sl1 or "
+      "FILE.cli (binary: the binary CLI form); layer_mm, pixel_mm (default the voxel size), tolerance_mm (CLI "
+      "simplification, default a quarter pixel), slab_mm (evaluate slab by slab; None: only when the whole part does "
+      "not fit max_memory_gb). Every layer is checked first; returns the report dict (as `--json` prints it), raises "
+      "CheckFailedError (with .report) when a layer fails and nothing is written.");
 
   m.def(
       "voxelize",

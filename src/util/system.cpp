@@ -60,17 +60,14 @@ uint64_t peak_child_memory_bytes() {
 
 void StageTimer::start(const std::string& stage) {
   stop();
-  // A stage started again adds to its first entry.
-  auto same = std::find_if(seconds_.begin(), seconds_.end(), [&](const auto& s) { return s.first == stage; });
-  current_ = size_t(same - seconds_.begin());
-  if (same == seconds_.end()) seconds_.emplace_back(stage, 0.0);
+  seconds_.emplace_back(stage, 0.0);
   started_ = std::chrono::steady_clock::now();
   running_ = true;
 }
 
 void StageTimer::stop() {
   if (!running_) return;
-  seconds_[current_].second +=
+  seconds_.back().second +=
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
   running_ = false;
 }

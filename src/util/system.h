@@ -26,7 +26,7 @@ uint64_t current_memory_bytes();
 // Wall-clock seconds per named stage, in the order the stages ran.
 class StageTimer {
  public:
-  // Starts timing `stage`; the previous stage, if any, ends now. A stage timed before adds to its total.
+  // Starts timing `stage`; the previous stage, if any, ends now.
   void start(const std::string& stage);
   // Ends the current stage.
   void stop();
@@ -35,7 +35,6 @@ class StageTimer {
  private:
   std::vector<std::pair<std::string, double>> seconds_;
   std::chrono::steady_clock::time_point started_;
-  size_t current_ = 0;  // the running stage's entry
   bool running_ = false;
 };
 

@@ -142,3 +142,21 @@ def test_sl1_archive_matches_prusaslicer(tmp_path):
         # the boundary only.
         disagree = int((np.abs(x - y) > 128).sum())
         assert disagree <= 0.25 * boundary / step_y + 4, (k, disagree)
+
+
+def test_python_slice_is_the_command_lines(tmp_path):
+    """lacuna.slice on a recipe dict: the same bytes as `lacuna slice`, slab by slab too, and the report."""
+    import lacuna
+
+    recipe = json.loads((SOURCE_DIR / "samples" / "hollow_sphere.json").read_text())
+    (tmp_path / "r.json").write_text(json.dumps(recipe))
+    report = slice_json(tmp_path / "r.json", "-o", tmp_path / "cli.cli", "--layer-mm", 0.4, "--binary")
+    mine = lacuna.slice(recipe, tmp_path / "py.cli", layer_mm=0.4, binary=True)
+    assert (tmp_path / "py.cli").read_bytes() == (tmp_path / "cli.cli").read_bytes()
+    assert mine["layer_count"] == report["layer_count"] == 50 and mine["valid"] and mine["slabs"] == 1
+    slabs = lacuna.slice(recipe, tmp_path / "slabs.cli", layer_mm=0.4, binary=True, slab_mm=4)
+    assert slabs["slabs"] >= 4 and slabs["halo_mm"] > 0
+    assert (tmp_path / "slabs.cli").read_bytes() == (tmp_path / "cli.cli").read_bytes()
+    with pytest.raises(ValueError, match="layer_mm"):
+        lacuna.slice(recipe, tmp_path / "bad.cli", layer_mm=-1)
+    assert not (tmp_path / "bad.cli").exists()

@@ -4,7 +4,6 @@
 
 #include <cstdlib>
 #include <limits>
-#include <numeric>
 
 #include "cli/mpi_ranks.h"
 #include "errors.h"
@@ -39,28 +38,24 @@ class MpiRanks : public SliceRanks {
   }
 
   std::vector<std::string> gather(const std::string& bytes) override {
-    // MPI counts are ints: a rank's layers past 2 GB (figures and contours, not images) are refused
-    // everywhere, before anything is sent.
-    const int64_t too_large = max(bytes.size() > size_t(std::numeric_limits<int>::max()) ? 1 : 0);
-    if (too_large)
-      throw ResourceLimit("a process's layers (figures and contours) exceed 2 GB; use more processes or a larger "
-                          "--tolerance-mm");
-    const int mine = int(bytes.size());
+    // MPI counts are ints: every process learns every size first, so all refuse together when the
+    // layers (figures and contours, not images) exceed 2 GB, before anything is sent.
+    const int64_t mine = int64_t(bytes.size());
+    std::vector<int64_t> sizes(size_t(size_), 0);
+    MPI_Allgather(&mine, 1, MPI_INT64_T, sizes.data(), 1, MPI_INT64_T, MPI_COMM_WORLD);
+    int64_t total = 0;
+    for (int64_t n : sizes) total += n;
+    if (total > std::numeric_limits<int>::max())
+      throw ResourceLimit("the processes' layers (figures and contours) exceed 2 GB together; use a larger "
+                          "--tolerance-mm or thicker layers");
     std::vector<int> counts(size_t(size_), 0), offsets(size_t(size_), 0);
-    MPI_Gather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
-    std::vector<std::string> out;
-    std::string all;
-    if (rank_ == 0) {
-      int64_t total = 0;
-      for (int r = 0; r < size_; ++r) {
-        offsets[size_t(r)] = int(total);
-        total += counts[size_t(r)];
-        if (total > std::numeric_limits<int>::max())
-          throw ResourceLimit("the processes' layers together exceed 2 GB; use a larger --tolerance-mm");
-      }
-      all.resize(size_t(total));
+    for (int r = 0; r < size_; ++r) {
+      counts[size_t(r)] = int(sizes[size_t(r)]);
+      if (r > 0) offsets[size_t(r)] = offsets[size_t(r - 1)] + counts[size_t(r - 1)];
     }
-    MPI_Gatherv(bytes.data(), mine, MPI_BYTE, all.data(), counts.data(), offsets.data(), MPI_BYTE, 0, MPI_COMM_WORLD);
+    std::string all(rank_ == 0 ? size_t(total) : 0, '\0');
+    MPI_Gatherv(bytes.data(), int(mine), MPI_BYTE, all.data(), counts.data(), offsets.data(), MPI_BYTE, 0, MPI_COMM_WORLD);
+    std::vector<std::string> out;
     if (rank_ == 0)
       for (int r = 0; r < size_; ++r) out.push_back(all.substr(size_t(offsets[size_t(r)]), size_t(counts[size_t(r)])));
     return out;

@@ -181,6 +181,21 @@ def run(
 ) -> RunResult:
     """Runs a recipe (path, JSON text or dict) as `lacuna run`: checked files, all or nothing."""
 
+def slice(
+    recipe: _Recipe,
+    output: _Path,
+    object: str = "",
+    layer_mm: Optional[float] = None,
+    pixel_mm: Optional[float] = None,
+    tolerance_mm: Optional[float] = None,
+    binary: bool = False,
+    slab_mm: Optional[float] = None,
+    voxel_size_mm: Optional[float] = None,
+    max_memory_gb: Optional[float] = None,
+    threads: Optional[int] = None,
+) -> Dict[str, Any]:
+    """Layers for printers (PNG folder, .zip, .sl1, .cli) as `lacuna slice`: checked, all or nothing."""
+
 def voxelize(
     recipe: _Recipe,
     object: str = "",
