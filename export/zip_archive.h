@@ -4,11 +4,15 @@
 
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace lacuna {
 
 struct ZipEntry {
+  ZipEntry() = default;
+  ZipEntry(std::string entry_name, std::string_view entry_bytes, bool compress = true, std::string from_file = {})
+      : name(std::move(entry_name)), bytes(entry_bytes), deflate(compress), file(std::move(from_file)) {}
   std::string name;
   std::string_view bytes;  // the caller keeps them alive until the archive is made
   bool deflate = true;  // false: stored (already compressed data, such as PNG)

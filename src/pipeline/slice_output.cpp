@@ -445,11 +445,11 @@ std::vector<ZipEntry> layer_archive_entries(const SlicedLayers& sliced, std::vec
   if (sliced.report.format == LayerFormat::kSl1) {
     texts.push_back(sl1_config_ini(sliced.job, sliced.printer));
     texts.push_back(sl1_prusaslicer_ini(sliced.job, sliced.printer));
-    entries = {{"config.ini", texts[0], true, {}}, {"prusaslicer.ini", texts[1], true, {}}};
+    entries = {{"config.ini", texts[0], true}, {"prusaslicer.ini", texts[1], true}};
     for (size_t k = 0; k < sliced.stack.layers; ++k) names.push_back(sl1_layer_name(sliced.job.name, k));
   } else {
     texts.push_back(layer_manifest(sliced.stack));
-    entries = {{"manifest.json", texts[0], true, {}}};
+    entries = {{"manifest.json", texts[0], true}};
     for (size_t k = 0; k < sliced.stack.layers; ++k) names.push_back(layer_file_name(k));
   }
   for (size_t k = 0; k < sliced.stack.layers; ++k)
