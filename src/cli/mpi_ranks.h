@@ -3,6 +3,7 @@
 // mpirun (src/cli/mpi/no_mpi.cpp), so that K copies never write the same files side by side.
 #pragma once
 
+#include <cstdlib>
 #include <memory>
 
 #include "pipeline/slice_output.h"
@@ -10,7 +11,10 @@
 namespace lacuna {
 
 // Whether mpirun started this process (its environment says so).
-bool launched_by_mpirun();
+inline bool launched_by_mpirun() {
+  return std::getenv("OMPI_COMM_WORLD_SIZE") != nullptr || std::getenv("PMI_SIZE") != nullptr ||
+         std::getenv("PMIX_RANK") != nullptr;
+}
 
 // The job's ranks, MPI initialised until they are destroyed; null when mpirun did not start this
 // process. Throws InvalidInput when it did but this build has no MPI.

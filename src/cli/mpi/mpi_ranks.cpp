@@ -2,7 +2,6 @@
 // main thread (the workers are TBB's, inside one rank), so MPI_THREAD_FUNNELED is enough.
 #include <mpi.h>
 
-#include <cstdlib>
 #include <limits>
 
 #include "cli/mpi_ranks.h"
@@ -66,11 +65,6 @@ class MpiRanks : public SliceRanks {
 };
 
 }  // namespace
-
-bool launched_by_mpirun() {
-  return std::getenv("OMPI_COMM_WORLD_SIZE") != nullptr || std::getenv("PMI_SIZE") != nullptr ||
-         std::getenv("PMIX_RANK") != nullptr;
-}
 
 std::unique_ptr<SliceRanks> mpi_ranks() {
   if (!launched_by_mpirun()) return nullptr;

@@ -1,15 +1,9 @@
 // The stand-in for builds without MPI (see src/cli/mpi_ranks.h).
-#include <cstdlib>
 
 #include "cli/mpi_ranks.h"
 #include "errors.h"
 
 namespace lacuna {
-
-bool launched_by_mpirun() {
-  return std::getenv("OMPI_COMM_WORLD_SIZE") != nullptr || std::getenv("PMI_SIZE") != nullptr ||
-         std::getenv("PMIX_RANK") != nullptr;
-}
 
 std::unique_ptr<SliceRanks> mpi_ranks() {
   if (launched_by_mpirun())
