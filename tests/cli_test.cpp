@@ -716,6 +716,67 @@ TEST(Cli, BcifsRulesPlateAndMeasure) {
   EXPECT_EQ(read_file(dir / "m" / "plate_plot.png").substr(1, 3), "PNG");
 }
 
+// `bcifs measure` of a bcifs_volume: the plain cube's 6^i cells and (1 - s^3)^i volumes, the lacunar cube's
+// tunnels; `run` reports the same exact volume; a bad cell and a face shared with different types are named.
+TEST(Cli, BcifsVolumeMeasureAndErrors) {
+  TempDir dir;
+  write_file(dir / "v.json", R"({"voxel_size_mm": 0.1, "inputs": {
+      "plain": {"type": "bcifs_volume", "cell": "hexahedron", "edge_mm": 10, "walls": "plain", "interior": "plain",
+                "level": 2, "lacuna_scale": 0.5},
+      "open": {"type": "bcifs_volume", "cell": "hexahedron", "edge_mm": 10, "edge": "B2", "params": "B2 B2 B2",
+               "level": 1, "lacuna_scale": 0.5, "center_mm": [20, 0, 0]}},
+      "outputs": [{"of": "plain", "file": "plain.stl"}]})");
+  Result m = lacuna("bcifs measure " + quote((dir / "v.json").string()) + " --levels 0..4 --json", dir.path());
+  ASSERT_EQ(m.code, 0) << m.err;
+  const nlohmann::json plain = nlohmann::json::parse(m.out)["plain"];
+  EXPECT_EQ(plain["topology"][0]["cells"], (nlohmann::json{1, 6, 36, 216, 1296}));
+  EXPECT_EQ(plain["topology"][0]["lacunas"], (nlohmann::json{0, 1, 7, 43, 259}));
+  for (int i = 0; i <= 4; ++i)
+    EXPECT_NEAR(plain["volume_mm3"][size_t(i)].get<double>(), 1000 * std::pow(0.875, i), 1e-9) << i;
+  EXPECT_NEAR(plain["F_V"].get<double>(), 0.875, 1e-12);
+  const nlohmann::json open = nlohmann::json::parse(m.out)["open"];
+  EXPECT_EQ(open["tunnels"][1], 6);
+  EXPECT_EQ(open["genus"][1], 5);
+  EXPECT_FALSE(fs::exists(dir / "v_measures"));  // no pictures for volumes, so no folder
+
+  Result r = lacuna("run " + quote((dir / "v.json").string()) + " -o " + quote((dir / "out").string()) + " --json",
+                    dir.path());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json in = nlohmann::json::parse(read_file(dir / "out" / "report.json"))["inputs"]["plain"];
+  EXPECT_NEAR(in["volume_mm3"].get<double>(), 1000 * 0.875 * 0.875, 1e-9);
+  EXPECT_EQ(in["cells"], 36);
+  EXPECT_EQ(in["lacunas"], 7);
+
+  write_file(dir / "bad.json", R"({"voxel_size_mm": 0.1, "inputs": {
+      "v": {"type": "bcifs_volume", "cell": "dodecahedron", "edge_mm": 10}},
+      "outputs": [{"of": "v", "file": "v.stl"}]})");
+  Result bad = lacuna("run " + quote((dir / "bad.json").string()) + " -o " + quote((dir / "bad").string()), dir.path());
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("inputs.v.cell"), std::string::npos) << bad.err;
+  EXPECT_NE(bad.err.find("dodecahedron"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(dir / "bad"));
+  // Two cubes whose shared face is walked the same way by both (the second's corners listed mirrored).
+  write_file(dir / "twice.json", R"({"voxel_size_mm": 0.1, "inputs": {
+      "v": {"type": "bcifs_volume", "cells": [
+        {"cell": "hexahedron", "edge_mm": 10},
+        {"corners_mm": [[5,-5,-5],[15,-5,-5],[5,5,-5],[15,5,-5],[5,-5,5],[15,-5,5],[5,5,5],[15,5,5]],
+         "faces": [[0,2,3,1],[4,5,7,6],[0,1,5,4],[2,6,7,3],[0,4,6,2],[1,3,7,5]]}]}},
+      "outputs": [{"of": "v", "file": "v.stl"}]})");
+  Result twice = lacuna("run " + quote((dir / "twice.json").string()) + " -o " + quote((dir / "t").string()), dir.path());
+  ASSERT_EQ(twice.code, 0) << twice.err;  // a proper second cube: the face at x = 5 is shared
+  EXPECT_EQ(nlohmann::json::parse(read_file(dir / "t" / "report.json"))["inputs"]["v"]["shared_faces"], 1);
+  write_file(dir / "inside_out.json", R"({"voxel_size_mm": 0.1, "inputs": {
+      "v": {"type": "bcifs_volume", "cells": [
+        {"corners_mm": [[5,-5,-5],[15,-5,-5],[5,5,-5],[15,5,-5],[5,-5,5],[15,-5,5],[5,5,5],[15,5,5]],
+         "faces": [[0,1,3,2],[4,6,7,5],[0,4,5,1],[2,3,7,6],[0,2,6,4],[1,5,7,3]]}]}},
+      "outputs": [{"of": "v", "file": "v.stl"}]})");
+  Result inside_out = lacuna("run " + quote((dir / "inside_out.json").string()) + " -o " + quote((dir / "io").string()),
+                             dir.path());
+  EXPECT_EQ(inside_out.code, 2);
+  EXPECT_NE(inside_out.err.find("counter-clockwise seen from outside"), std::string::npos) << inside_out.err;
+  EXPECT_NE(inside_out.err.find("inputs.v.cells"), std::string::npos) << inside_out.err;
+}
+
 // A lacunar cube: at level 0 its faces are whole, and the cell is the cube shell s^3 - (s - 2t)^3 (two
 // components: the cavity is sealed); at level 1 every face has its lacuna and every C2 edge one gap, where the
 // notches of both faces open the edge: a sphere with 6 + 12 openings, thickened, has genus 17.

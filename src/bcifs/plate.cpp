@@ -61,7 +61,10 @@ std::vector<std::vector<Vec2d>> union_loops(const std::vector<std::vector<Vec2d>
 CellKind cell_kind_from_name(const std::string& name) {
   if (name == "hexahedron") return CellKind::kHexahedron;
   if (name == "truncated_tetrahedron") return CellKind::kTruncatedTetrahedron;
-  throw InvalidInput("expected \"hexahedron\" or \"truncated_tetrahedron\", got \"" + name + "\"");
+  if (name == "tetrahedron") return CellKind::kTetrahedron;
+  if (name == "prism") return CellKind::kPrism;
+  throw InvalidInput("expected \"hexahedron\", \"truncated_tetrahedron\", \"tetrahedron\" or \"prism\", got \"" +
+                     name + "\"");
 }
 
 std::vector<std::vector<Vec3d>> cell_faces(CellKind cell, double edge_mm) {
@@ -72,6 +75,37 @@ std::vector<std::vector<Vec3d>> cell_faces(CellKind cell, double edge_mm) {
     for (const auto& f : std::vector<std::array<int, 4>>{
              {0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}})
       faces.push_back({corner(f[0]), corner(f[1]), corner(f[2]), corner(f[3])});
+    return faces;
+  }
+  // Orient a face counter-clockwise seen from outside (the centre is the origin).
+  auto outward = [](std::vector<Vec3d> f) {
+    Vec3d n{0, 0, 0}, c{0, 0, 0};
+    for (size_t k = 0; k < f.size(); ++k) {
+      n += cross(f[k], f[(k + 1) % f.size()]);
+      c += f[k];
+    }
+    if (dot(n, c) < 0) std::reverse(f.begin(), f.end());
+    return f;
+  };
+  if (cell == CellKind::kTetrahedron) {
+    const double h = edge_mm / (2 * std::sqrt(2.0));
+    const std::array<Vec3d, 4> t = {Vec3d{h, h, h}, Vec3d{h, -h, -h}, Vec3d{-h, h, -h}, Vec3d{-h, -h, h}};
+    for (const auto& f : std::vector<std::array<int, 3>>{{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}})
+      faces.push_back(outward({t[size_t(f[0])], t[size_t(f[1])], t[size_t(f[2])]}));
+    return faces;
+  }
+  if (cell == CellKind::kPrism) {
+    const double r = edge_mm / std::sqrt(3.0), h = edge_mm / 2;
+    std::array<Vec3d, 3> bottom, top;
+    for (int k = 0; k < 3; ++k) {
+      const double pi = std::acos(-1.0), a = pi / 2 + 2 * pi * k / 3;
+      bottom[size_t(k)] = {r * std::cos(a), r * std::sin(a), -h};
+      top[size_t(k)] = {r * std::cos(a), r * std::sin(a), h};
+    }
+    faces.push_back(outward({bottom[0], bottom[1], bottom[2]}));
+    faces.push_back(outward({top[0], top[1], top[2]}));
+    for (size_t k = 0; k < 3; ++k)
+      faces.push_back(outward({bottom[k], bottom[(k + 1) % 3], top[(k + 1) % 3], top[k]}));
     return faces;
   }
   // The regular tetrahedron (1,1,1), (1,-1,-1), (-1,1,-1), (-1,-1,1) (edge 2 sqrt 2) with each corner cut a

@@ -43,14 +43,14 @@ std::vector<std::vector<Vec2d>> plate_loops(const Plate& plate, int level);
 // points), as closed loops: the edges without their reverse, chained.
 std::vector<std::vector<Vec2d>> union_loops(const std::vector<std::vector<Vec2d>>& polygons);
 
-enum class CellKind { kHexahedron, kTruncatedTetrahedron };
+enum class CellKind { kHexahedron, kTruncatedTetrahedron, kTetrahedron, kPrism };
 
-// "hexahedron" or "truncated_tetrahedron"; throws InvalidInput for another name.
+// "hexahedron", "truncated_tetrahedron", "tetrahedron" or "prism"; throws InvalidInput for another name.
 CellKind cell_kind_from_name(const std::string& name);
 
 // The faces of a polyhedral cell centred at the origin, each counter-clockwise seen from outside:
-// a hexahedron (a cube of edge `edge_mm`) or a truncated tetrahedron (4 triangles and 4 hexagons, all
-// edges `edge_mm`).
+// a hexahedron (a cube of edge `edge_mm`), a truncated tetrahedron (4 triangles and 4 hexagons), a regular
+// tetrahedron or a prism (an equilateral triangle extruded along z by its edge), every edge `edge_mm`.
 std::vector<std::vector<Vec3d>> cell_faces(CellKind cell, double edge_mm);
 
 }  // namespace bcifs

@@ -541,6 +541,13 @@ Lacunarity lacunarity(const RuleSet& rules, int type, int levels) {
     for (const SubFace& sub : rule.subfaces) s(t, local[size_t(sub.type)]) += 1;
   }
 
+  return lacunarity(s, l, levels);
+}
+
+Lacunarity lacunarity(const Eigen::MatrixXd& s, const Eigen::VectorXd& l, int levels) {
+  const Eigen::Index count = s.rows();
+  if (count < 1 || s.cols() != count || l.size() != count || levels < 0)
+    throw InvalidInput("lacunarity: expected a square substitution matrix, one lacuna count per type and levels >= 0");
   Lacunarity out;
   Eigen::VectorXd c = Eigen::VectorXd::Ones(count), lac = Eigen::VectorXd::Zero(count);
   for (int i = 0; i <= levels; ++i) {

@@ -200,6 +200,10 @@ struct Lacunarity {
 // The topological measures of face type `type` for levels 0..levels. Throws InvalidInput for a bad type or
 // levels < 0.
 Lacunarity lacunarity(const RuleSet& rules, int type, int levels);
+// The same for type 0 of any substitution system: s(t, u) children of type u in the rule of t, l(t) the lacunas a
+// rule of type t makes at level 1 (lacunar volumes count their cells this way). Throws InvalidInput unless s is
+// square with one l per row and levels >= 0.
+Lacunarity lacunarity(const Eigen::MatrixXd& s, const Eigen::VectorXd& l, int levels);
 
 // The rule set as JSON: face_types [{id, boundary (canonical, ["C2", ...]), delay, algorithm, edges {Ea, El, Ec},
 // children (one id per sub-face), subfaces [{boundary as written, type, shift, incidence}], adjacency, lacunas_1}],

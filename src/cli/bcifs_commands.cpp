@@ -89,6 +89,38 @@ int bcifs_measure(const BcifsArgs& a) {
   nlohmann::json result = nlohmann::json::object();
   std::vector<std::pair<std::string, std::vector<uint8_t>>> images;  // written only once everything worked
   for (const auto& [name, value] : top["inputs"].items()) {
+    if (value.is_object() && value.value("type", "") == "bcifs_volume") {
+      nlohmann::json object = value;
+      object.erase("type");
+      const std::string path = "inputs." + name;
+      const BcifsVolumeInput input = parse_bcifs_volume_input(JsonObject(object, a.recipe, path));
+      VolumeCellMeasures m;
+      try {
+        m = measure_volume(input.spec, input.options, hi);
+      } catch (const InvalidInput& e) {
+        throw InvalidInput(a.recipe + ": " + path + ": " + e.what());
+      }
+      nlohmann::json cells = nlohmann::json::array();
+      for (size_t c = 0; c < m.cells.size(); ++c) {
+        const bcifs::Lacunarity& l = m.cells[c];
+        cells.push_back({{"type", m.cell_types[c]}, {"cells", l.subfaces}, {"lacunas", l.lacunas}, {"ratio", l.ratio},
+                         {"r_limit", l.limit}, {"spectral_radius", l.spectral_radius}});
+      }
+      const bcifs::VolumeMeasures& g = m.geometry;
+      result[name] = {{"kind", "volume"},
+                      {"topology", cells},
+                      {"cell_types", m.cell_type_count},
+                      {"face_types", m.face_type_count},
+                      {"levels", {0, hi}},
+                      {"geometry_levels", {0, m.geometry_last}},
+                      {"volume_mm3", g.volume},
+                      {"surface_mm2", g.surface},
+                      {"F_V", g.volume_factor},
+                      {"F_S", g.surface_factor},
+                      {"tunnels", g.tunnels},
+                      {"genus", g.genus}};
+      continue;
+    }
     if (!value.is_object() || value.value("type", "") != "bcifs_plate") continue;
     nlohmann::json object = value;
     object.erase("type");
@@ -127,8 +159,9 @@ int bcifs_measure(const BcifsArgs& a) {
     entry["plot"] = plot_file;
     result[name] = entry;
   }
-  if (result.empty()) throw InvalidInput(a.recipe + ": inputs: no input of type \"bcifs_plate\" to measure");
-  fs::create_directories(out_dir);
+  if (result.empty())
+    throw InvalidInput(a.recipe + ": inputs: no input of type \"bcifs_plate\" or \"bcifs_volume\" to measure");
+  if (!images.empty()) fs::create_directories(out_dir);
   for (const auto& [path, bytes] : images) {
     const std::string temp = path + ".part";
     std::ofstream out(temp, std::ios::binary);
@@ -146,6 +179,20 @@ int bcifs_measure(const BcifsArgs& a) {
   }
   for (const auto& [name, e] : result.items()) {
     std::printf("%s:\n", name.c_str());
+    if (e.value("kind", "") == "volume") {
+      for (size_t i = 0; i < e["volume_mm3"].size(); ++i)
+        std::printf("  level %zu: volume %.6g mm3, surface %.6g mm2, tunnels %g, genus %g\n", i,
+                    e["volume_mm3"][i].get<double>(), e["surface_mm2"][i].get<double>(), e["tunnels"][i].get<double>(),
+                    e["genus"][i].get<double>());
+      std::printf("  F_V %.6g, F_S %.6g (levels 0..%d); %d cell types, %d face types\n", e["F_V"].get<double>(),
+                  e["F_S"].get<double>(), e["geometry_levels"][1].get<int>(), e["cell_types"].get<int>(),
+                  e["face_types"].get<int>());
+      for (const auto& c : e["topology"])
+        std::printf("  cell type %d: N^C %g, N^L %g, R_%d %.6g, R %.9g\n", c["type"].get<int>(),
+                    c["cells"].back().get<double>(), c["lacunas"].back().get<double>(), hi,
+                    c["ratio"].back().get<double>(), c["r_limit"].get<double>());
+      continue;
+    }
     for (size_t i = 0; i < e["area_mm2"].size(); ++i)
       std::printf("  level %d: area %.6g mm2, perimeter %.6g mm\n", lo + int(i), e["area_mm2"][i].get<double>(),
                   e["perimeter_mm"][i].get<double>());
@@ -174,7 +221,9 @@ std::function<int()> add_bcifs_commands(CLI::App& app) {
   rules->add_option("--delay", args->delay, "Delay of the face (1: none)")->check(CLI::Range(1, 16));
   rules->add_flag("--json", args->json, "Print JSON");
   CLI::App* measure = bcifs->add_subcommand(
-      "measure", "Topological and geometric measures of the bcifs_plate inputs of a recipe, with density maps and plots");
+      "measure",
+      "Topological and geometric measures of the bcifs_plate inputs of a recipe, with density maps and plots, and of "
+      "its bcifs_volume inputs (cells, lacunas, volumes, surfaces, tunnels, genus)");
   measure->add_option("recipe", args->recipe, "Recipe file")->required();
   measure->add_option("--levels", args->levels,
                       "Levels A..B (default 0..4): the counts N^C, N^L, R from 0 to B (at most 12), areas, perimeters "

@@ -568,6 +568,39 @@ class Builder {
     out_.report = report;
   }
 
+  // Cells subdivided in 3D: the level's sub-cells as convex pieces (lacunas and tunnels are what is left out).
+  void add(const BcifsVolumeInput& v) {
+    bcifs::VolumeRules rules;
+    try {
+      rules = bcifs::build_volume_rules(v.spec);
+    } catch (const InvalidInput& e) {
+      fail("", e.what());
+    } catch (const ResourceLimit& e) {
+      throw ResourceLimit(where() + ": " + e.what());
+    }
+    const double cells = bcifs::volume_cells(rules, v.level);
+    if (cells > bcifs::kMaxVolumeCells)
+      throw ResourceLimit(where() + ".level: level " + std::to_string(v.level) + " has " +
+                          std::to_string(int64_t(cells)) + " cells, more than " +
+                          std::to_string(int64_t(bcifs::kMaxVolumeCells)) + "; use a lower level");
+    const bcifs::VolumeLevel level = bcifs::realize_volume(rules, v.spec, v.level, v.options);
+    BcifsVolumeReport report;
+    report.level = v.level;
+    report.cells = level.cells.size();
+    const bcifs::Lacunarity l = bcifs::volume_lacunarity(rules, rules.roots[0], v.level);
+    for (int root : rules.roots) report.lacunas += bcifs::volume_lacunarity(rules, root, v.level).lacunas.back();
+    report.r_limit = l.limit;
+    report.cell_types = rules.cells.size();
+    report.face_types = rules.faces.rules.size();
+    report.shared_faces = rules.shared.size();
+    for (const bcifs::VolumeCell& c : level.cells) report.volume_mm3 += bcifs::cell_volume(level, c, v.spec);
+    for (ConvexCells& pieces : bcifs::convex_pieces(level, v.spec)) {
+      report.pieces += pieces.size();
+      out_.geometry.cells.push_back(std::move(pieces));
+    }
+    out_.report = report;
+  }
+
   const RecipeInput& in_;
   const BuildContext& context_;
   const Recipe& recipe_;

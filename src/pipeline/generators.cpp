@@ -258,4 +258,20 @@ PlateMeasures measure_plate(const bcifs::Plate& plate, int first, int last) {
   return m;
 }
 
+VolumeCellMeasures measure_volume(const bcifs::VolumeSpec& spec, const bcifs::VolumeGeometryOptions& options, int last) {
+  if (last < 0 || last > kMaxTopologyLevel)
+    throw InvalidInput("levels: expected a last level from 0 to " + std::to_string(kMaxTopologyLevel) + ", got " +
+                       std::to_string(last));
+  const bcifs::VolumeRules rules = bcifs::build_volume_rules(spec);
+  VolumeCellMeasures m;
+  m.cell_types = rules.roots;
+  for (int root : rules.roots) m.cells.push_back(bcifs::volume_lacunarity(rules, root, last));
+  m.cell_type_count = rules.cells.size();
+  m.face_type_count = rules.faces.rules.size();
+  while (m.geometry_last < last && bcifs::volume_cells(rules, m.geometry_last + 1) <= kMaxMeasuredCells)
+    ++m.geometry_last;
+  m.geometry = bcifs::volume_measures(rules, spec, m.geometry_last, options);
+  return m;
+}
+
 }  // namespace lacuna

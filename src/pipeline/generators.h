@@ -13,6 +13,7 @@
 #include "bcifs/plate.h"
 #include "bcifs/realize.h"
 #include "bcifs/topology.h"
+#include "bcifs/volume.h"
 #include "cifs/automaton.h"
 #include "curves/curves.h"
 #include "geometry.h"
@@ -127,5 +128,21 @@ constexpr int kMaxGeometryLevel = 8;
 // Measures the plate: its counts from level 0 to `last`, its geometry from `first` to min(last, 8)
 // (0 <= first <= 8, first <= last <= 12). Throws InvalidInput for other levels.
 PlateMeasures measure_plate(const bcifs::Plate& plate, int first, int last);
+
+// What `bcifs measure` finds for one lacunar volume.
+struct VolumeCellMeasures {
+  std::vector<bcifs::Lacunarity> cells;  // per cell of the assembly, its counts N^C, N^L, R at levels 0 .. last
+  std::vector<int> cell_types;           // per cell, its type in the rules
+  size_t cell_type_count = 0, face_type_count = 0;
+  bcifs::VolumeMeasures geometry;        // volumes, surfaces, tunnels, genus of levels 0 .. geometry_last
+  int geometry_last = 0;                 // min(last, the deepest level with at most kMaxMeasuredCells cells)
+};
+
+// The most cells `bcifs measure` realizes for a volume's geometry (a few hundred MB).
+constexpr double kMaxMeasuredCells = 300000;
+
+// Measures a lacunar volume (a bcifs_volume input's cells and geometry options) from level 0 to `last` (at most
+// 12). Throws InvalidInput for a bad level or spec.
+VolumeCellMeasures measure_volume(const bcifs::VolumeSpec& spec, const bcifs::VolumeGeometryOptions& options, int last);
 
 }  // namespace lacuna

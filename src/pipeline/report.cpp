@@ -90,6 +90,13 @@ nlohmann::json to_json(const InputReport& report) {
             return nlohmann::json{{"faces", r.faces}, {"face_types", r.face_types}, {"holes", r.holes},
                                   {"face_area_mm2", r.face_area_mm2}};
           },
+          [](const BcifsVolumeReport& r) {
+            return nlohmann::json{{"level", r.level},           {"cells", r.cells},
+                                  {"lacunas", r.lacunas},       {"r_limit", r.r_limit},
+                                  {"cell_types", r.cell_types}, {"face_types", r.face_types},
+                                  {"shared_faces", r.shared_faces}, {"pieces", r.pieces},
+                                  {"volume_mm3", r.volume_mm3}};
+          },
       },
       report);
 }

@@ -82,9 +82,22 @@ struct BcifsCellReport {
   double face_area_mm2 = 0;
 };
 
+struct BcifsVolumeReport {
+  int level = 0;
+  size_t cells = 0;         // sub-cells at the level (N^C)
+  double lacunas = 0;       // N^L at the level
+  double r_limit = 0;       // lim R of the first cell
+  size_t cell_types = 0;
+  size_t face_types = 0;
+  size_t shared_faces = 0;  // faces two cells of the assembly share
+  size_t pieces = 0;        // convex pieces handed to the rasterizer
+  double volume_mm3 = 0;    // the cells' volume, exact (the solid is this less what the voxels round off)
+};
+
 // What building an input found; most inputs have nothing to report.
 using InputReport = std::variant<std::monostate, CurveReport, MotifFillReport, VolumeFillReport, VoronoiSpheresReport,
-                                 VoronoiWallsReport, BcifsPlateReport, BcifsCellReport>;
+                                 VoronoiWallsReport, BcifsPlateReport, BcifsCellReport,
+                                 BcifsVolumeReport>;
 
 // An object's printability, analysed before it was meshed (again after the fixes, when asked for).
 struct PrintabilityFindings {

@@ -419,6 +419,11 @@ const char* kInputDocs[][2] = {
     {"bcifs_cell",
      "A polyhedral cell with lacunar faces: cell (hexahedron, truncated_tetrahedron), edge_mm, thickness_mm, "
      "center_mm, edge, params, algorithm, level (2), gap_fraction, lacuna_scale, notch_depth."},
+    {"bcifs_volume",
+     "Cells subdivided in 3D around lacunas: cell (hexahedron, tetrahedron, truncated_tetrahedron, prism), edge_mm, "
+     "center_mm, delay, or corners_mm + faces, or cells (a list of those); walls (lacunar, plain), edge, params, "
+     "algorithm, interior (lacunar, plain), radial, interior_params, interior_algorithm, level (2), lacuna_scale (0.5), "
+     "face_lacuna_scale, gap_fraction, notch_depth."},
 };
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include "bcifs/plate.h"
 #include "bcifs/realize.h"
 #include "bcifs/topology.h"
+#include "bcifs/volume.h"
 #include "cifs/automaton.h"
 #include "cifs/solid_input.h"
 #include "curves/curves.h"
@@ -214,11 +215,20 @@ struct BcifsCellInput {
   bcifs::RealizeOptions options;
 };
 
+// "bcifs_volume": one cell, or an assembly of cells sharing faces, subdivided in 3D around lacunas to a level.
+struct BcifsVolumeInput {
+  bcifs::VolumeSpec spec;
+  int level = 2;
+  bcifs::VolumeGeometryOptions options;
+  size_t shared_faces = 0;
+};
+
 // One input's options, by type.
 using InputSpec =
     std::variant<SphereInput, SpheresInput, CapsuleInput, TubesInput, BoxInput, CylinderInput, TorusInput, RegionInput,
                  MeshInput, SurfaceInput, LatticeInput, CifsInput, CurveInput, FillMotifsInput, FillSpheresInput,
-                 VoronoiSpheresInput, VoronoiTilesInput, VoronoiFoamInput, BcifsPlateInput, BcifsCellInput>;
+                 VoronoiSpheresInput, VoronoiTilesInput, VoronoiFoamInput, BcifsPlateInput, BcifsCellInput,
+                 BcifsVolumeInput>;
 
 // The other inputs this one is built from (fit_to, cover), in no particular order.
 std::vector<std::string> dependencies(const InputSpec& spec);

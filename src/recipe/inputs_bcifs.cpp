@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "errors.h"
+#include "bcifs/volume.h"
 #include "recipe/input_parsers.h"
 
 namespace lacuna {
@@ -180,4 +181,107 @@ BcifsCellInput parse_bcifs_cell_input(const JsonObject& o) {
   options.defaults.notch_depth = fraction(o, "notch_depth", options.defaults.notch_depth);
   return in;
 }
+
+namespace {
+
+template <class T>
+T parsed(const JsonObject& o, const char* key, const std::string& fallback, T (*parse)(const std::string&)) {
+  try {
+    return parse(o.string_or(key, fallback));
+  } catch (const InvalidInput& e) {
+    o.fail(key, e.what());
+  }
+}
+
+// One cell of a bcifs_volume: a regular cell (cell, edge_mm, center_mm) or any convex polyhedron (corners_mm and
+// faces, corner loops counter-clockwise seen from outside), and its delay.
+CellSpec parse_volume_cell(const JsonObject& o, const FaceType& face, bool plain) {
+  CellSpec cell;
+  if (o.has("corners_mm")) {
+    if (o.has("cell") || o.has("edge_mm")) o.fail("corners_mm", "give either corners_mm and faces or cell and edge_mm");
+    cell.shape.corners_mm = o.vec3_list("corners_mm");
+    if (cell.shape.corners_mm.size() < 4 || cell.shape.corners_mm.size() > 1000)
+      o.fail("corners_mm", "expected 4 to 1000 corners");
+    const nlohmann::json& faces = o.required("faces");
+    if (!faces.is_array() || faces.size() < 4 || faces.size() > 1000)
+      o.fail("faces", "expected 4 to 1000 faces, each a list of 0-based corner indices");
+    for (size_t f = 0; f < faces.size(); ++f) {
+      const std::string at = o.path_of("faces") + "[" + std::to_string(f) + "]";
+      if (!faces[f].is_array() || faces[f].size() < 3 || faces[f].size() > 64)
+        throw InvalidInput(o.file() + ": " + at + ": expected a list of 3 to 64 corner indices");
+      std::vector<int> loop;
+      for (const auto& k : faces[f]) {
+        if (!k.is_number_unsigned() || k.get<uint64_t>() >= cell.shape.corners_mm.size())
+          throw InvalidInput(o.file() + ": " + at + ": expected corner indices from 0 to " +
+                             std::to_string(cell.shape.corners_mm.size() - 1));
+        loop.push_back(int(k.get<uint64_t>()));
+      }
+      cell.shape.faces.push_back(std::move(loop));
+    }
+  } else {
+    CellKind kind = CellKind::kHexahedron;
+    try {
+      kind = cell_kind_from_name(o.string_or("cell", "hexahedron"));
+    } catch (const InvalidInput& e) {
+      o.fail("cell", e.what());
+    }
+    cell.shape = regular_cell(kind, o.positive_length("edge_mm"), o.vec3_or("center_mm", Vec3d{}));
+  }
+  const uint64_t delay = o.unsigned_integer_or("delay", 1);
+  if (delay < 1 || delay > 8) o.fail("delay", "expected a delay from 1 to 8");
+  cell.delay = int(delay);
+  for (const auto& loop : cell.shape.faces) {
+    FaceType t = face;
+    t.boundary.assign(loop.size(), face.boundary[0]);
+    cell.face_types.push_back(t);
+    cell.plain.push_back(plain ? 1 : 0);
+  }
+  return cell;
+}
+
+}  // namespace
+
+BcifsVolumeInput parse_bcifs_volume_input(const JsonObject& o) {
+  BcifsVolumeInput in;
+  const std::string faces = o.string_or("walls", "lacunar");
+  if (faces != "lacunar" && faces != "plain") o.fail("walls", "expected \"lacunar\" or \"plain\"");
+  FaceType face;
+  face.boundary = {parsed(o, "edge", "C2", parse_edge)};
+  face.edges = parsed(o, "params", "C2 B2 B2", parse_edge_set);
+  face.algorithm = parsed(o, "algorithm", "A1", parse_algorithm);
+  const std::string interior = o.string_or("interior", "lacunar");
+  if (interior != "lacunar" && interior != "plain") o.fail("interior", "expected \"lacunar\" or \"plain\"");
+  InteriorFaces& inner = in.spec.interior;
+  inner.plain = interior == "plain";
+  inner.radial = parsed(o, "radial", "B2", parse_edge);
+  inner.edges = o.has("interior_params") ? parsed(o, "interior_params", "", parse_edge_set) : face.edges;
+  inner.algorithm = o.has("interior_algorithm") ? parsed(o, "interior_algorithm", "", parse_algorithm) : face.algorithm;
+  if (o.has("cells")) {
+    if (o.has("cell") || o.has("edge_mm") || o.has("corners_mm") || o.has("delay"))
+      o.fail("cells", "give the cells either as a list in \"cells\" or as one cell, not both");
+    const nlohmann::json& list = o.required("cells");
+    if (!list.is_array() || list.empty() || list.size() > 1000) o.fail("cells", "expected a list of 1 to 1000 cells");
+    for (size_t i = 0; i < list.size(); ++i) {
+      const JsonObject c(list[i], o.file(), o.path_of("cells") + "[" + std::to_string(i) + "]");
+      c.allow_only({"cell", "edge_mm", "center_mm", "corners_mm", "faces", "delay"});
+      in.spec.cells.push_back(parse_volume_cell(c, face, faces == "plain"));
+    }
+  } else {
+    in.spec.cells.push_back(parse_volume_cell(o, face, faces == "plain"));
+  }
+  try {
+    in.shared_faces = shared_faces(in.spec).size();
+  } catch (const InvalidInput& e) {
+    o.fail(o.has("cells") ? "cells" : "", e.what());
+  }
+  const uint64_t level = o.unsigned_integer_or("level", 2);
+  if (level > 6) o.fail("level", "expected a level from 0 to 6");
+  in.level = int(level);
+  in.options.lacuna_scale = fraction(o, "lacuna_scale", in.options.lacuna_scale);
+  in.options.faces.lacuna_scale = fraction(o, "face_lacuna_scale", in.options.faces.lacuna_scale);
+  in.options.faces.gap_fraction = fraction(o, "gap_fraction", in.options.faces.gap_fraction);
+  in.options.faces.notch_depth = fraction(o, "notch_depth", in.options.faces.notch_depth);
+  return in;
+}
+
 }  // namespace lacuna

@@ -84,6 +84,11 @@ const std::map<std::string, InputType>& types() {
               {"cell", "edge_mm", "center_mm", "edge", "params", "algorithm", "level", "thickness_mm", "gap_fraction",
                "lacuna_scale", "notch_depth"},
               parse_as<BcifsCellInput, parse_bcifs_cell_input>},
+             {"bcifs_volume",
+              {"cell", "edge_mm", "center_mm", "corners_mm", "faces", "delay", "cells", "walls", "edge", "params",
+               "algorithm", "interior", "radial", "interior_params", "interior_algorithm", "level", "lacuna_scale",
+               "face_lacuna_scale", "gap_fraction", "notch_depth"},
+              parse_as<BcifsVolumeInput, parse_bcifs_volume_input>},
          })
       t.emplace(type.type, type);
     return t;

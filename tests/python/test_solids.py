@@ -181,6 +181,19 @@ def test_bcifs_plate_and_cell():
     assert cell.components == 1 and cell.volume_mm3 > 0
 
 
+def test_bcifs_volume_opens_a_cube_into_a_handlebody():
+    # Level 1: six frusta around a cubic lacuna (half the edge), each face's central hole a tunnel into it:
+    # a hollow cube with six windows, genus 5. Plain walls seal the lacuna: genus 0, two shells, and the volume
+    # is the cube's less the lacuna's, (1 - 0.5^3) of it.
+    keys = dict(cell="hexahedron", edge_mm=8, level=1, edge="B2", params="B2 B2 B2", lacuna_scale=0.5)
+    opened = lacuna.bcifs_volume(**keys).mesh(voxel_size_mm=0.1)
+    assert opened.components == 1 and opened.genus == 5
+    sealed = lacuna.bcifs_volume(walls="plain", interior="plain", **keys).mesh(voxel_size_mm=0.1)
+    assert sealed.genus == 0 and sealed.components == 2
+    near(sealed.volume_mm3, 512 * (1 - 0.125), 0.005)
+    assert opened.volume_mm3 < sealed.volume_mm3
+
+
 def test_union_difference_intersection_of_spheres():
     a = lacuna.sphere(radius_mm=3)
     b = lacuna.sphere(center_mm=[3.5, 0.4, 0], radius_mm=2)

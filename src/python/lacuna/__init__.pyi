@@ -394,7 +394,7 @@ def bcifs_plate(
 ) -> Solid: ...
 def bcifs_cell(
     *,
-    cell: Literal["hexahedron", "truncated_tetrahedron"] = ...,
+    cell: Literal["hexahedron", "truncated_tetrahedron", "tetrahedron", "prism"] = ...,
     edge_mm: float = ...,
     thickness_mm: float = ...,
     center_mm: _Vec3 = ...,
@@ -404,6 +404,29 @@ def bcifs_cell(
     level: int = ...,
     gap_fraction: float = ...,
     lacuna_scale: float = ...,
+    notch_depth: float = ...,
+) -> Solid: ...
+def bcifs_volume(
+    *,
+    cell: Literal["hexahedron", "truncated_tetrahedron", "tetrahedron", "prism"] = ...,
+    edge_mm: float = ...,
+    center_mm: _Vec3 = ...,
+    delay: int = ...,
+    corners_mm: Sequence[_Vec3] = ...,
+    faces: Sequence[Sequence[int]] = ...,
+    cells: Sequence[Mapping[str, Any]] = ...,
+    walls: Literal["lacunar", "plain"] = ...,
+    edge: str = ...,
+    params: str = ...,
+    algorithm: str = ...,
+    interior: Literal["lacunar", "plain"] = ...,
+    radial: str = ...,
+    interior_params: str = ...,
+    interior_algorithm: str = ...,
+    level: int = ...,
+    lacuna_scale: float = ...,
+    face_lacuna_scale: float = ...,
+    gap_fraction: float = ...,
     notch_depth: float = ...,
 ) -> Solid: ...
 

@@ -1,0 +1,273 @@
+// Lacunar volumes: rules and counts against closed forms (the plain hexahedron's 6^i, the tetrahedron's
+// prisms and hexahedra), volumes against (1 - s^3)^k and against the faces' own 2D areas, the cells a level
+// realizes against the rules' counts, shared faces of an assembly of mixed cells with delays, and bad specs.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "bcifs/realize.h"
+#include "bcifs/topology.h"
+#include "bcifs/volume.h"
+#include "errors.h"
+#include "solids/check.h"
+#include "solids/extract.h"
+#include "solids/voxelize.h"
+
+namespace lacuna {
+namespace {
+
+using namespace bcifs;
+
+FaceType quad_face(const std::string& edge, const std::string& params, int delay = 1) {
+  return FaceType{std::vector<EdgeType>(4, parse_edge(edge)), parse_edge_set(params), Algorithm::kA1, delay};
+}
+
+// A cell whose faces all have one edge type (or are all plain).
+CellSpec uniform_cell(const Polyhedron& shape, bool plain, const std::string& edge = "B2",
+                      const std::string& params = "B2 B2 B2", int delay = 1) {
+  CellSpec c;
+  c.shape = shape;
+  c.delay = delay;
+  for (const auto& f : shape.faces) {
+    c.face_types.push_back(FaceType{std::vector<EdgeType>(f.size(), parse_edge(edge)), parse_edge_set(params),
+                                    Algorithm::kA1, 1});
+    c.plain.push_back(plain ? 1 : 0);
+  }
+  return c;
+}
+
+VolumeSpec plain_spec(CellKind kind, double edge) {
+  VolumeSpec spec;
+  spec.cells.push_back(uniform_cell(regular_cell(kind, edge), true));
+  spec.interior.plain = true;
+  return spec;
+}
+
+// convex_pieces grows every piece by a relative 1e-9: its volume by (1 + 1e-9)^3.
+const double kGrown = std::pow(1 + 1e-9, 3);
+
+double total_volume(const VolumeLevel& level, const VolumeSpec& spec) {
+  double v = 0;
+  for (const VolumeCell& c : level.cells) v += cell_volume(level, c, spec);
+  return v;
+}
+
+// The volume of convex pieces, each from its faces oriented away from its corners' average.
+double pieces_volume(const std::vector<ConvexCells>& pieces) {
+  double v = 0;
+  for (const ConvexCells& cells : pieces)
+    for (size_t k = 0; k < cells.size(); ++k) {
+      const Vec3d* p = cells.corners_mm.data() + k * size_t(cells.corners_per_cell);
+      Vec3d c{0, 0, 0};
+      for (int i = 0; i < cells.corners_per_cell; ++i) c += p[i];
+      c = c / double(cells.corners_per_cell);
+      for (const auto& face : cells.faces) {
+        double part = 0;
+        for (size_t j = 1; j + 1 < face.size(); ++j)
+          part += dot(p[face[0]] - c, cross(p[face[j]] - c, p[face[j + 1]] - c));
+        v += std::fabs(part) / 6;
+      }
+    }
+  return v;
+}
+
+TEST(BcifsVolume, PlainHexahedronIsSixHexahedraAroundALacuna) {
+  const VolumeSpec spec = plain_spec(CellKind::kHexahedron, 10);
+  const VolumeRules rules = build_volume_rules(spec);
+  ASSERT_EQ(rules.cells.size(), 1u);  // the frustum over a plain square is a plain hexahedron again
+  ASSERT_EQ(rules.cells[0].children.size(), 6u);
+  const Lacunarity l = volume_lacunarity(rules, rules.roots[0], 6);
+  for (int i = 0; i <= 6; ++i) {
+    EXPECT_EQ(l.subfaces[size_t(i)], std::pow(6.0, i));
+    EXPECT_EQ(l.lacunas[size_t(i)], (std::pow(6.0, i) - 1) / 5);
+  }
+  EXPECT_NEAR(l.limit, 1.0 / 6, 1e-12);  // N^L_1 / (N^L_1 + N^C_1 - 1)
+
+  const double s = 0.5;
+  VolumeGeometryOptions options;
+  options.lacuna_scale = s;
+  for (int k = 0; k <= 3; ++k) {
+    const VolumeLevel level = realize_volume(rules, spec, k, options);
+    ASSERT_EQ(level.cells.size(), size_t(std::pow(6, k)));
+    for (const VolumeCell& c : level.cells) EXPECT_EQ(c.faces.size(), 6u);
+    // Every sub-cell is a frustum towards its parent's centre: (1 - s^3) of the parent per level.
+    EXPECT_NEAR(total_volume(level, spec), 1000 * std::pow(1 - s * s * s, k), 1e-9);
+    EXPECT_NEAR(pieces_volume(convex_pieces(level, spec)), 1000 * std::pow(1 - s * s * s, k) * kGrown, 1e-9);
+  }
+  const VolumeMeasures m = volume_measures(rules, spec, 3, options);
+  EXPECT_NEAR(m.volume_factor, 1 - s * s * s, 1e-12);
+  EXPECT_NEAR(m.surface[0], 600, 1e-9);
+  // Level 1: the cube's faces and the lacuna's (the six hexahedra share their slanted sides).
+  EXPECT_NEAR(m.surface[1], 600 * (1 + s * s), 1e-9);
+}
+
+TEST(BcifsVolume, PlainTetrahedronMakesPrismsThenHexahedra) {
+  // A tetrahedron's four frusta are triangular prisms; a prism's five are two prisms and three hexahedra.
+  const VolumeSpec spec = plain_spec(CellKind::kTetrahedron, 10);
+  const VolumeRules rules = build_volume_rules(spec);
+  EXPECT_EQ(rules.cells.size(), 3u);
+  const Lacunarity l = volume_lacunarity(rules, rules.roots[0], 4);
+  // t -> 4p, p -> 2p + 3h, h -> 6h: N_1 = 4, N_2 = 4 * 5, N_3 = 4 (2 * 5 + 3 * 6), N_4 = 4 (2 * 28 + 3 * 36).
+  EXPECT_EQ(l.subfaces[1], 4);
+  EXPECT_EQ(l.subfaces[2], 20);
+  EXPECT_EQ(l.subfaces[3], 112);
+  EXPECT_EQ(l.subfaces[4], 4 * (2 * 28 + 3 * 36));
+  const double v0 = std::pow(10.0, 3) / (6 * std::sqrt(2.0));
+  for (CellKind kind : {CellKind::kTetrahedron, CellKind::kPrism, CellKind::kTruncatedTetrahedron}) {
+    const VolumeSpec sp = plain_spec(kind, 10);
+    const VolumeRules r = build_volume_rules(sp);
+    const VolumeLevel zero = realize_volume(r, sp, 0);
+    const double base = total_volume(zero, sp);
+    const double closed_form = kind == CellKind::kTetrahedron ? v0
+                               : kind == CellKind::kPrism     ? std::sqrt(3.0) / 4 * 1000
+                                                              : 23 * std::sqrt(2.0) / 12 * 1000;
+    EXPECT_NEAR(base, closed_form, 1e-9);
+    const VolumeLevel two = realize_volume(r, sp, 2);
+    EXPECT_EQ(double(two.cells.size()), volume_lacunarity(r, r.roots[0], 2).subfaces[2]);
+    EXPECT_NEAR(total_volume(two, sp), base * std::pow(1 - 0.125, 2), 1e-9);
+  }
+}
+
+TEST(BcifsVolume, LacunarFacesOpenTheWallsAndTheCountsAgree) {
+  VolumeSpec spec;
+  spec.cells.push_back(uniform_cell(regular_cell(CellKind::kHexahedron, 10), false, "B2", "B2 B2 B2"));
+  const VolumeRules rules = build_volume_rules(spec);
+  const Lacunarity l = volume_lacunarity(rules, rules.roots[0], 3);
+  // <B2 B2 B2 B2> under A1: four corner pentagons per face.
+  EXPECT_EQ(l.subfaces[1], 24);
+  VolumeGeometryOptions options;
+  options.lacuna_scale = 0.5;
+  for (int k = 1; k <= 3; ++k) {
+    const VolumeLevel level = realize_volume(rules, spec, k, options);
+    EXPECT_EQ(double(level.cells.size()), l.subfaces[size_t(k)]) << "level " << k;
+    for (int owners : level.owners) EXPECT_TRUE(owners == 1 || owners == 2);
+  }
+
+  // Level 1 from the faces' own 2D realization: each face's sub-faces (its area less its lacuna) times the
+  // frustum factor (1 - s^3) h / 3, h = 5 the distance from the centre.
+  const RuleSet faces2d = build_rules(quad_face("B2", "B2 B2 B2"));
+  const std::vector<Vec2d> square{{0, 0}, {10, 0}, {10, 10}, {0, 10}};
+  const GeometricMeasures g = geometric_measures(faces2d, 0, square, 1, RealizeOptions{});
+  const double s = 0.5;
+  const double expected = 6 * g.area[1] * 5 / 3 * (1 - s * s * s);
+  const VolumeLevel one = realize_volume(rules, spec, 1, options);
+  EXPECT_NEAR(total_volume(one, spec), expected, 1e-9);
+  EXPECT_LT(g.area[1], 100 - 1);  // the walls really are opened
+  // The convex pieces (pentagons are convex here) hold the same volume.
+  EXPECT_NEAR(pieces_volume(convex_pieces(one, spec)), expected * kGrown, 1e-9);
+}
+
+// The solid of a hexahedron with Bezier walls at level 2: one component whose genus is the tunnels less the
+// lacunas counted on the cells (6 + 24 * 5 - 25 = 101), and whose volume is the cells' exact volume.
+TEST(BcifsVolume, SolidGenusAndVolumeMatchTheCells) {
+  VolumeSpec spec;
+  spec.cells.push_back(uniform_cell(regular_cell(CellKind::kHexahedron, 20), false, "B2", "B2 B2 B2"));
+  const VolumeRules rules = build_volume_rules(spec);
+  VolumeGeometryOptions options;
+  options.lacuna_scale = 0.5;
+  const VolumeMeasures m = volume_measures(rules, spec, 2, options);
+  ASSERT_EQ(m.genus.size(), 3u);
+  EXPECT_EQ(m.genus[1], 5);  // six faces opened into one lacuna: a hollow cube with six windows
+  EXPECT_EQ(m.tunnels[2], 6 * 4 * 2 + 24 * 3);  // 48 pentagons (outer and inner) and 72 distinct side quads
+  EXPECT_EQ(m.genus[2], 101);
+  GeometrySet geometry;
+  geometry.cells = convex_pieces(realize_volume(rules, spec, 2, options), spec);
+  const MeshCheckReport r = check_mesh(extract_surface(voxelize(geometry, VolumeOptions{0.125, 3.0})));
+  EXPECT_TRUE(r.valid()) << ::testing::PrintToString(r.problems());
+  EXPECT_EQ(r.components, 1u);
+  EXPECT_EQ(double(r.genus), m.genus[2]);
+  EXPECT_NEAR(r.volume_mm3, m.volume[2], 0.01 * m.volume[2]);
+}
+
+TEST(BcifsVolume, NotchedSubFacesAreSplitIntoConvexPieces) {
+  // Faces delayed by 2: each has one sub-face, its boundary notched at the Cantor gaps (a non-convex octagon
+  // with four notches), so the first level's six frusta are not convex.
+  VolumeSpec spec;
+  spec.cells.push_back(uniform_cell(regular_cell(CellKind::kHexahedron, 10), false, "C2", "C2 B2 B2"));
+  for (FaceType& f : spec.cells[0].face_types) f.delay = 2;
+  const VolumeRules rules = build_volume_rules(spec);
+  EXPECT_EQ(volume_cells(rules, 1), 6);
+  for (int k = 1; k <= 2; ++k) {
+    const VolumeLevel level = realize_volume(rules, spec, k);
+    const std::vector<ConvexCells> pieces = convex_pieces(level, spec);
+    size_t count = 0;
+    for (const ConvexCells& p : pieces) count += p.size();
+    EXPECT_GT(count, level.cells.size());  // notched (non-convex) bases were split
+    EXPECT_NEAR(pieces_volume(pieces), total_volume(level, spec) * kGrown, 1e-9);
+  }
+}
+
+// A cube and a prism on its +x face, the prism delayed by 2: the face they share is subdivided identically
+// from both sides at every level, so every sub-face on it belongs to two cells.
+TEST(BcifsVolume, AssemblyOfMixedCellsAndDelaysSharesItsFaceAtEveryLevel) {
+  VolumeSpec spec;
+  spec.interior.plain = true;
+  const Polyhedron cube = regular_cell(CellKind::kHexahedron, 10);
+  spec.cells.push_back(uniform_cell(cube, false, "B2", "B2 B2 B2"));
+  Polyhedron prism;
+  const double r = 5 + 5 * std::sqrt(3.0);
+  prism.corners_mm = {{5, -5, -5}, {5, 5, -5}, {r, 0, -5}, {5, -5, 5}, {5, 5, 5}, {r, 0, 5}};
+  prism.faces = {{0, 1, 2}, {3, 5, 4}, {0, 3, 4, 1}, {1, 4, 5, 2}, {2, 5, 3, 0}};
+  spec.cells.push_back(uniform_cell(prism, false, "B2", "B2 B2 B2", 2));
+  const VolumeRules rules = build_volume_rules(spec);
+  ASSERT_EQ(rules.shared.size(), 1u);
+  EXPECT_EQ(rules.shared[0].cell_a, 0);
+  EXPECT_EQ(rules.shared[0].cell_b, 1);
+  // The shared face carries the prism's delay from both sides.
+  const int shared_type = find_type(rules.faces, quad_face("B2", "B2 B2 B2", 2));
+  ASSERT_GE(shared_type, 0);
+  const Lacunarity face = lacunarity(rules.faces, shared_type, 4);
+  EXPECT_EQ(face.subfaces[1], 1);
+  for (int k = 1; k <= 4; ++k) {
+    const VolumeLevel level = realize_volume(rules, spec, k);
+    int on_plane = 0, twice = 0;
+    for (size_t f = 0; f < level.faces.size(); ++f) {
+      bool in = true;
+      for (const Vec3d& p : level.faces[f].polygon) in = in && std::fabs(p.x - 5) < 1e-9;
+      if (!in) continue;
+      ++on_plane;
+      twice += level.owners[f] == 2;
+    }
+    EXPECT_EQ(on_plane, twice) << "level " << k;
+    EXPECT_EQ(double(twice), face.subfaces[size_t(k)]) << "level " << k;
+    EXPECT_EQ(double(level.cells.size()), volume_cells(rules, k)) << "level " << k;
+  }
+}
+
+TEST(BcifsVolume, BadSpecsAreNamed) {
+  auto message = [](const VolumeSpec& spec) {
+    try {
+      build_volume_rules(spec);
+    } catch (const InvalidInput& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  VolumeSpec mixed;
+  mixed.cells.push_back(uniform_cell(regular_cell(CellKind::kHexahedron, 10), false));
+  mixed.cells[0].face_types[2].boundary = std::vector<EdgeType>(4, parse_edge("C2"));
+  EXPECT_NE(message(mixed).find("cell 0 face"), std::string::npos) << message(mixed);
+  EXPECT_NE(message(mixed).find("is C2 but the same edge of face"), std::string::npos) << message(mixed);
+
+  VolumeSpec bent;
+  bent.cells.push_back(uniform_cell(regular_cell(CellKind::kHexahedron, 10), true));
+  bent.cells[0].shape.corners_mm[0].x += 0.5;
+  EXPECT_NE(message(bent).find("not planar"), std::string::npos) << message(bent);
+
+  VolumeSpec open;
+  open.cells.push_back(uniform_cell(regular_cell(CellKind::kHexahedron, 10), true));
+  open.cells[0].shape.faces.pop_back();
+  open.cells[0].face_types.pop_back();
+  open.cells[0].plain.pop_back();
+  EXPECT_NE(message(open).find("not closed"), std::string::npos) << message(open);
+
+  VolumeSpec level;
+  level.cells.push_back(uniform_cell(regular_cell(CellKind::kHexahedron, 10), false));
+  const VolumeRules rules = build_volume_rules(level);
+  EXPECT_THROW(realize_volume(rules, level, 8), ResourceLimit);
+}
+
+}  // namespace
+}  // namespace lacuna
