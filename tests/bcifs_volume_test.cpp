@@ -3,6 +3,7 @@
 // realizes against the rules' counts, shared faces of an assembly of mixed cells with delays, and bad specs.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -234,6 +235,34 @@ TEST(BcifsVolume, AssemblyOfMixedCellsAndDelaysSharesItsFaceAtEveryLevel) {
     EXPECT_EQ(double(twice), face.subfaces[size_t(k)]) << "level " << k;
     EXPECT_EQ(double(level.cells.size()), volume_cells(rules, k)) << "level " << k;
   }
+}
+
+// Cells of edges 1 to 4 mm: without delays the last subdivision's lacunas keep that 4x spread; with the delays
+// by size 1 and 2 mm round to one delay and keep their factor 2, so the spread halves (delays are whole levels and
+// a level shrinks these cells about 3.5 times: two cells end within that of each other, 1.5 is out of reach for
+// sizes between two delays); cells whose sizes differ by whole levels' shrinks get lacunas within 1.5.
+TEST(BcifsVolume, DelaysBySizeEqualizeTheLacunas) {
+  VolumeSpec one;
+  one.cells.push_back(uniform_cell(regular_cell(CellKind::kHexahedron, 1), false, "B2", "B2 B2 B2"));
+  const double shrink = level_shrink(one, 0);
+  EXPECT_GT(shrink, 3);
+  EXPECT_LT(shrink, 4);
+  auto spread = [&](const std::vector<double>& edges, bool delayed) {
+    VolumeSpec spec;
+    const std::vector<int> delays = delays_for_sizes(edges, 3, shrink);
+    for (size_t c = 0; c < edges.size(); ++c) {
+      spec.cells.push_back(uniform_cell(regular_cell(CellKind::kHexahedron, edges[c], {10.0 * double(c), 0, 0}),
+                                        false, "B2", "B2 B2 B2"));
+      if (delayed) spec.cells.back().delay = delays[c];
+    }
+    const std::vector<double> sizes = last_lacuna_sizes(build_volume_rules(spec), spec, 3);
+    for (double s : sizes) EXPECT_GT(s, 0);
+    return *std::max_element(sizes.begin(), sizes.end()) / *std::min_element(sizes.begin(), sizes.end());
+  };
+  EXPECT_NEAR(spread({1, 2, 4}, false), 4, 1e-9);  // the same subdivision at three scales
+  EXPECT_NEAR(spread({1, 2, 4}, true), 2, 0.05);
+  EXPECT_EQ(delays_for_sizes({1, shrink, shrink * shrink}, 3, shrink), (std::vector<int>{3, 2, 1}));
+  EXPECT_LT(spread({1, shrink, shrink * shrink}, true), 1.5);
 }
 
 TEST(BcifsVolume, BadSpecsAreNamed) {

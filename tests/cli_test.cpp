@@ -12,6 +12,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "export/mesh_io.h"
 #include "fill/fill.h"
 #include "tests/test_support.h"
 #include <regex>
@@ -775,6 +776,52 @@ TEST(Cli, BcifsVolumeMeasureAndErrors) {
   EXPECT_EQ(inside_out.code, 2);
   EXPECT_NE(inside_out.err.find("counter-clockwise seen from outside"), std::string::npos) << inside_out.err;
   EXPECT_NE(inside_out.err.find("inputs.v.cells"), std::string::npos) << inside_out.err;
+}
+
+// A 15 mm box filled with lacunar tetrahedra inside a 1 mm skin: the grid of 6 mm cubes reaches 0.5 mm past the
+// 12 mm grid cell into the inset (half-side 6.5), so the outer tetrahedra are moved to a twelfth of their depth
+// and come out less than half as large: they are delayed, every cell lies inside the inset, and the delays bring
+// the last level's lacunas closer in size than without them.
+TEST(Cli, BcifsInfillConformsToTheHull) {
+  TempDir dir;
+  write_file(dir / "fill.json", R"({"voxel_size_mm": 0.1, "inputs": {
+      "box": {"type": "box", "min_mm": [-7.5, -7.5, -7.5], "max_mm": [7.5, 7.5, 7.5]},
+      "equal": {"type": "bcifs_infill", "hull": "box", "skin_mm": 1, "cell_mm": 6, "level": 2, "edge": "B2",
+                "params": "B2 B2 B2", "lacuna_scale": 0.5, "face_lacuna_scale": 0.7},
+      "plain": {"type": "bcifs_infill", "hull": "box", "skin_mm": 1, "cell_mm": 6, "level": 2, "edge": "B2",
+                "params": "B2 B2 B2", "lacuna_scale": 0.5, "face_lacuna_scale": 0.7, "equal_lacunas": false},
+      "sealed": {"type": "bcifs_infill", "hull": "box", "skin_mm": 1, "cell_mm": 6, "level": 1, "walls": "plain",
+                 "interior": "plain", "lacuna_scale": 0.5}},
+      "outputs": [{"of": "equal", "file": "equal.stl"}, {"of": "sealed", "file": "sealed.stl"}]})");
+  Result r = lacuna("run " + quote((dir / "fill.json").string()) + " -o " + quote((dir / "out").string()) + " --json",
+                    dir.path());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json outputs = nlohmann::json::parse(r.out)["outputs"];
+  const nlohmann::json inputs = nlohmann::json::parse(read_file(dir / "out" / "report.json"))["inputs"];
+  const nlohmann::json equal = inputs["equal"], plain = inputs["plain"];
+  EXPECT_TRUE(outputs[0]["checks"]["valid"].get<bool>());
+  EXPECT_GT(equal["tetrahedra"].get<int>(), 50);
+  EXPECT_EQ(equal["tetrahedra"], plain["tetrahedra"]);
+  EXPECT_LT(equal["cell_mm"][0].get<double>(), 0.5 * equal["cell_mm"][1].get<double>());
+  EXPECT_EQ(equal["max_delay"], 2);
+  EXPECT_EQ(plain["max_delay"], 1);
+  EXPECT_LT(equal["volume_mm3"].get<double>(), 13.0 * 13.0 * 13.0);
+  // With plain walls every tetrahedron keeps 7/8 of itself around a sealed lacuna: the mesh's volume is the
+  // cells' exact volume (which overlapping tetrahedra would lower), and the lacunas are cavities (those of the
+  // flattest tetrahedra by the surface are thinner than a voxel and vanish).
+  const nlohmann::json sealed = inputs["sealed"];
+  EXPECT_NEAR(outputs[1]["volume_mm3"].get<double>(), sealed["volume_mm3"].get<double>(),
+              0.03 * sealed["volume_mm3"].get<double>());
+  EXPECT_GT(outputs[1]["components"].get<double>(), 0.5 * sealed["lacunas"].get<double>());
+  const double spread_equal = equal["lacuna_mm"][1].get<double>() / equal["lacuna_mm"][0].get<double>();
+  const double spread_plain = plain["lacuna_mm"][1].get<double>() / plain["lacuna_mm"][0].get<double>();
+  EXPECT_LT(spread_equal, spread_plain);
+  EXPECT_LT(spread_equal, 3.6);  // within one level's shrink (about 3.5)
+  const TriMesh cells = read_mesh((dir / "out" / "equal.stl").string());
+  double farthest = 0;
+  for (const Vec3d& p : cells.positions_mm)
+    farthest = std::max({farthest, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
+  EXPECT_LT(farthest, 6.5 + 0.2);  // the inset, give or take the voxels
 }
 
 // A lacunar cube: at level 0 its faces are whole, and the cell is the cube shell s^3 - (s - 2t)^3 (two

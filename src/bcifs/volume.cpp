@@ -426,6 +426,7 @@ class Realizer {
       cell.type = rules_.roots[c];
       cell.delay = spec_.cells[c].delay;
       cell.root = int(c);
+      cell.origin = int(c);
       cell.faces = roots.object[c];
       for (int f : cell.faces) ++out.owners[size_t(f)];
       cell.apex = corner_average(spec_.cells[c].shape.corners_mm);
@@ -478,6 +479,7 @@ class Realizer {
             const auto [qt, shift] = quad_of(rules_.faces.rules[size_t(g.type)].face.boundary[j]);
             child.faces.push_back(add(out, rotated(quad, shift), qt));
           }
+          child.origin = cell.origin;
           child.base = g.polygon;
           child.base_apex = c;
           child.base_scale = s;
@@ -701,6 +703,54 @@ std::vector<ConvexCells> convex_pieces(const VolumeLevel& level, const VolumeSpe
       for (size_t i = 0; i < m; ++i) p[i] = c + (p[i] - c) * (1 + 1e-9);
     }
   }
+  return out;
+}
+
+double level_shrink(const VolumeSpec& spec, int cell, const VolumeGeometryOptions& options) {
+  if (cell < 0 || cell >= int(spec.cells.size())) throw InvalidInput("level_shrink: no such cell");
+  VolumeSpec alone;
+  alone.interior = spec.interior;
+  alone.cells.push_back(spec.cells[size_t(cell)]);
+  alone.cells[0].delay = 1;
+  const VolumeRules rules = build_volume_rules(alone);
+  auto mean_size = [&](int level) {
+    const VolumeLevel l = realize_volume(rules, alone, level, options);
+    double sum = 0;
+    for (const VolumeCell& c : l.cells) sum += std::log(std::cbrt(cell_volume(l, c, alone)));
+    return std::exp(sum / double(l.cells.size()));
+  };
+  return mean_size(1) / mean_size(2);
+}
+
+std::vector<int> delays_for_sizes(const std::vector<double>& sizes_mm, int level, double shrink) {
+  if (level < 1) throw InvalidInput("delays_for_sizes: level must be >= 1");
+  if (!(shrink > 1 && std::isfinite(shrink))) throw InvalidInput("delays_for_sizes: the shrink must be > 1");
+  std::vector<int> delays;
+  if (sizes_mm.empty()) return delays;
+  for (double l : sizes_mm)
+    if (!(l > 0 && std::isfinite(l))) throw InvalidInput("delays_for_sizes: every size must be positive");
+  std::vector<double> sorted = sizes_mm;
+  std::sort(sorted.begin(), sorted.end());
+  const double reference = sorted[std::min(sorted.size() - 1, size_t(0.9 * double(sorted.size())))];
+  for (double l : sizes_mm) {
+    const double wait = std::round(std::log(reference / l) / std::log(shrink));
+    delays.push_back(int(std::clamp(1.0 + std::max(wait, 0.0), 1.0, double(level))));
+  }
+  return delays;
+}
+
+std::vector<double> last_lacuna_sizes(const VolumeRules& rules, const VolumeSpec& spec, int level,
+                                      const VolumeGeometryOptions& options) {
+  if (level < 1) throw InvalidInput("last_lacuna_sizes: level must be >= 1");
+  const VolumeLevel before = realize_volume(rules, spec, level - 1, options);
+  std::vector<double> log_sum(spec.cells.size(), 0.0), count(spec.cells.size(), 0.0);
+  for (const VolumeCell& cell : before.cells) {
+    if (cell.delay != 1) continue;
+    log_sum[size_t(cell.origin)] += std::log(options.lacuna_scale * std::cbrt(cell_volume(before, cell, spec)));
+    count[size_t(cell.origin)] += 1;
+  }
+  std::vector<double> out;
+  for (size_t c = 0; c < spec.cells.size(); ++c) out.push_back(count[c] > 0 ? std::exp(log_sum[c] / count[c]) : 0.0);
   return out;
 }
 

@@ -151,6 +151,7 @@ struct VolumeCell {
   int delay = 1;
   std::vector<int> faces;   // indices into VolumeLevel::faces
   int root = -1;
+  int origin = -1;          // the cell of the spec it descends from
   std::vector<Vec3d> base;
   Vec3d base_apex;
   double base_scale = 0;
@@ -180,6 +181,24 @@ double cell_volume(const VolumeLevel& level, const VolumeCell& cell, const Volum
 // grown by a relative 1e-9 about its corners' average, so that pieces sharing a face overlap and their union has
 // no crack where the face lies on a voxel plane.
 std::vector<ConvexCells> convex_pieces(const VolumeLevel& level, const VolumeSpec& spec);
+
+// How much one level shrinks a cell: the geometric mean of cbrt(volume) over its level-1 sub-cells divided by that
+// over its level-2 sub-cells, for cell `cell` of the spec subdivided alone without delay (about 3.4 for a cube or
+// a tetrahedron with Bezier B2 walls and lacuna scale 0.5).
+double level_shrink(const VolumeSpec& spec, int cell, const VolumeGeometryOptions& options = {});
+
+// Delays that give cells of different sizes lacunas of about one size: a cell of size L waits
+// 1 + round(log(L_ref / L) / log(shrink)) levels (at least 1, at most `level`), L_ref the 90th percentile of the
+// sizes (the largest cells but an outlier or two subdivide at once), shrink > 1 what one level does to a cell
+// (level_shrink). Delays are whole levels, so a cell's lacunas are within sqrt(shrink) of the reference's and
+// two cells' within shrink of each other (two sizes that round to one delay). Sizes must be > 0.
+std::vector<int> delays_for_sizes(const std::vector<double>& sizes_mm, int level, double shrink);
+
+// The size of the lacunas the last subdivision makes (level - 1 to level), per cell of the spec: the geometric
+// mean of lacuna_scale * cbrt(volume) over that cell's descendants that subdivide then; 0 for a cell whose
+// descendants are all still delayed.
+std::vector<double> last_lacuna_sizes(const VolumeRules& rules, const VolumeSpec& spec, int level,
+                                      const VolumeGeometryOptions& options = {});
 
 struct VolumeMeasures {
   std::vector<double> volume;   // V_i, i = 0..levels: the cells' volumes summed

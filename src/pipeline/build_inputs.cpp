@@ -9,6 +9,7 @@
 
 #include "bcifs/realize.h"
 #include "bcifs/topology.h"
+#include "bcifs/volume.h"
 #include "cifs/solid_input.h"
 #include "curves/curves.h"
 #include "curves/sweep.h"
@@ -22,6 +23,7 @@
 #include "solids/check.h"
 #include "solids/parameterize.h"
 #include "solids/repair.h"
+#include "solids/volume.h"
 #include "solids/voxelize.h"
 #include "util/progress.h"
 #include "util/system.h"
@@ -595,6 +597,153 @@ class Builder {
     report.shared_faces = rules.shared.size();
     for (const bcifs::VolumeCell& c : level.cells) report.volume_mm3 += bcifs::cell_volume(level, c, v.spec);
     for (ConvexCells& pieces : bcifs::convex_pieces(level, v.spec)) {
+      report.pieces += pieces.size();
+      out_.geometry.cells.push_back(std::move(pieces));
+    }
+    out_.report = report;
+  }
+
+  // A hull filled with lacunar cells: a grid of cubes of cell_mm, each split into six tetrahedra around its
+  // diagonal (Kuhn's split: neighbours split their common face alike), the tetrahedra that reach into the hull's
+  // inset (skin_mm in) kept and their outside corners moved onto the inset surface, so the cells conform to it.
+  // Tetrahedra keep every face planar however their corners move (a moved hexahedron would not). Faces two
+  // tetrahedra share are shared cells' faces, so the structure is consistent across them; delays by size give
+  // every cell lacunas of about one size.
+  void add(const BcifsInfillInput& b) {
+    const double h = b.cell_mm;
+    VolumeOptions coarse;
+    coarse.voxel_size_mm = std::max(vopt_.voxel_size_mm, h / 20);
+    coarse.half_band_voxels = (b.skin_mm + h) / coarse.voxel_size_mm + 3;
+    Volume inset = voxelize(geometry_of(b.hull), coarse);
+    if (b.skin_mm > 0) inset = offset(inset, -b.skin_mm);
+    if (inset.empty()) fail("skin_mm", "the hull is thinner than twice the skin: nothing is left to fill");
+    const Box3 box = inset.bounding_box();
+    std::array<int64_t, 3> lo{}, count{};
+    for (int a = 0; a < 3; ++a) {
+      lo[size_t(a)] = int64_t(std::floor(box.min[a] / h)) - 1;
+      count[size_t(a)] = int64_t(std::ceil(box.max[a] / h)) + 2 - lo[size_t(a)];
+    }
+    if (double(count[0]) * double(count[1]) * double(count[2]) > 4e6)
+      fail("cell_mm", "cells of " + message_number(h) + " mm make more than 4 000 000 grid corners in the hull; "
+                      "use larger cells");
+    auto index = [&](int64_t i, int64_t j, int64_t k) { return size_t((k * count[1] + j) * count[0] + i); };
+    const size_t corners = size_t(count[0] * count[1] * count[2]);
+    std::vector<Vec3d> point(corners);
+    std::vector<double> distance(corners);
+    for (int64_t k = 0; k < count[2]; ++k)
+      for (int64_t j = 0; j < count[1]; ++j)
+        for (int64_t i = 0; i < count[0]; ++i) {
+          const size_t v = index(i, j, k);
+          point[v] = Vec3d{double(lo[0] + i), double(lo[1] + j), double(lo[2] + k)} * h;
+          distance[v] = inset.distance_at(point[v]);
+        }
+    // Kuhn's six tetrahedra of a cube (corner bits x = 1, y = 2, z = 4), all around the diagonal 0-7.
+    static const int kKuhn[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7}, {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
+    std::vector<std::array<size_t, 4>> kept;
+    std::vector<char> moves(corners, 0);
+    for (int64_t k = 0; k + 1 < count[2]; ++k)
+      for (int64_t j = 0; j + 1 < count[1]; ++j)
+        for (int64_t i = 0; i + 1 < count[0]; ++i)
+          for (const auto& t : kKuhn) {
+            std::array<size_t, 4> c{};
+            bool inside = false;
+            for (int q = 0; q < 4; ++q) {
+              c[size_t(q)] = index(i + (t[q] & 1), j + ((t[q] >> 1) & 1), k + ((t[q] >> 2) & 1));
+              inside = inside || distance[c[size_t(q)]] < 0;
+            }
+            if (!inside) continue;
+            kept.push_back(c);
+            for (size_t q : c)
+              if (distance[q] >= 0) moves[q] = 1;
+          }
+    // Outside corners onto the inset surface: Newton steps along the distance's gradient.
+    const double step = coarse.voxel_size_mm;
+    std::vector<Vec3d> moved = point;
+    for (size_t v = 0; v < corners; ++v) {
+      if (!moves[v]) continue;
+      Vec3d p = point[v];
+      for (int it = 0; it < 4; ++it) {
+        const double d = inset.distance_at(p);
+        const Vec3d g{inset.distance_at(p + Vec3d{step, 0, 0}) - inset.distance_at(p - Vec3d{step, 0, 0}),
+                      inset.distance_at(p + Vec3d{0, step, 0}) - inset.distance_at(p - Vec3d{0, step, 0}),
+                      inset.distance_at(p + Vec3d{0, 0, step}) - inset.distance_at(p - Vec3d{0, 0, step})};
+        const double g2 = dot(g, g) / (4 * step * step);
+        if (!(g2 > 0.25)) break;  // no clear direction (beyond the band): leave it
+        p = p - g * (d / (2 * step) / g2);
+      }
+      moved[v] = p;
+    }
+    bcifs::VolumeSpec spec;
+    spec.interior = b.interior;
+    std::vector<double> sizes;
+    const double regular = h * h * h / 6;  // a Kuhn tetrahedron's volume
+    for (const auto& t : kept) {
+      bcifs::CellSpec c;
+      for (size_t q : t) c.shape.corners_mm.push_back(moved[q]);
+      const auto signed_volume = [](const std::vector<Vec3d>& p) {
+        return dot(p[1] - p[0], cross(p[2] - p[0], p[3] - p[0])) / 6;
+      };
+      std::vector<Vec3d> before;
+      for (size_t q : t) before.push_back(point[q]);
+      const double was = signed_volume(before), now = signed_volume(c.shape.corners_mm);
+      // Flattened or turned over by the move: dropped (the skin closes what is left there).
+      if (!(now * was > 0) || std::fabs(now) < 0.05 * regular) continue;
+      if (now < 0) std::swap(c.shape.corners_mm[1], c.shape.corners_mm[2]);
+      // Positively oriented (corner 3 on the side the normal of 0, 1, 2 points to): these run outward.
+      c.shape.faces = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}};
+      sizes.push_back(std::cbrt(6 * std::sqrt(2.0) * std::fabs(now)));  // the edge of a regular tetrahedron that large
+      for (int f = 0; f < 4; ++f) {
+        bcifs::FaceType t3 = b.face;
+        t3.boundary.assign(3, b.face.boundary[0]);
+        c.face_types.push_back(t3);
+        c.plain.push_back(b.plain ? 1 : 0);
+      }
+      spec.cells.push_back(std::move(c));
+    }
+    if (spec.cells.empty()) fail("cell_mm", "the inset hull holds no cell");
+    if (b.equal_lacunas) {
+      // What a level does to a full cell inside the hull (the largest: one the surface did not move).
+      const size_t reference = size_t(std::max_element(sizes.begin(), sizes.end()) - sizes.begin());
+      const double shrink = bcifs::level_shrink(spec, int(reference), b.options);
+      const std::vector<int> delays = bcifs::delays_for_sizes(sizes, b.level, shrink);
+      for (size_t c = 0; c < spec.cells.size(); ++c) spec.cells[c].delay = delays[c];
+    }
+    bcifs::VolumeRules rules;
+    try {
+      rules = bcifs::build_volume_rules(spec);
+    } catch (const InvalidInput& e) {
+      fail("", e.what());
+    } catch (const ResourceLimit& e) {
+      throw ResourceLimit(where() + ": " + e.what());
+    }
+    const double cells = bcifs::volume_cells(rules, b.level);
+    if (cells > bcifs::kMaxVolumeCells)
+      throw ResourceLimit(where() + ": " + std::to_string(spec.cells.size()) + " tetrahedra at level " +
+                          std::to_string(b.level) + " make " + std::to_string(int64_t(cells)) +
+                          " cells, more than " + std::to_string(int64_t(bcifs::kMaxVolumeCells)) +
+                          "; use larger cell_mm or a lower level");
+    const bcifs::VolumeLevel level = bcifs::realize_volume(rules, spec, b.level, b.options);
+    BcifsVolumeReport report;
+    report.level = b.level;
+    report.cells = level.cells.size();
+    for (int root : rules.roots) report.lacunas += bcifs::volume_lacunarity(rules, root, b.level).lacunas.back();
+    report.cell_types = rules.cells.size();
+    report.face_types = rules.faces.rules.size();
+    report.shared_faces = rules.shared.size();
+    report.tetrahedra = spec.cells.size();
+    report.min_cell_mm = *std::min_element(sizes.begin(), sizes.end());
+    report.max_cell_mm = *std::max_element(sizes.begin(), sizes.end());
+    for (const bcifs::CellSpec& c : spec.cells) report.max_delay = std::max(report.max_delay, c.delay);
+    // The lacunas the last level makes, per tetrahedron (those still all delayed make none).
+    report.min_lacuna_mm = HUGE_VAL;
+    for (double l : bcifs::last_lacuna_sizes(rules, spec, b.level, b.options))
+      if (l > 0) {
+        report.min_lacuna_mm = std::min(report.min_lacuna_mm, l);
+        report.max_lacuna_mm = std::max(report.max_lacuna_mm, l);
+      }
+    if (!(report.max_lacuna_mm > 0)) report.min_lacuna_mm = 0;
+    for (const bcifs::VolumeCell& c : level.cells) report.volume_mm3 += bcifs::cell_volume(level, c, spec);
+    for (ConvexCells& pieces : bcifs::convex_pieces(level, spec)) {
       report.pieces += pieces.size();
       out_.geometry.cells.push_back(std::move(pieces));
     }

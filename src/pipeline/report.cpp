@@ -91,11 +91,18 @@ nlohmann::json to_json(const InputReport& report) {
                                   {"face_area_mm2", r.face_area_mm2}};
           },
           [](const BcifsVolumeReport& r) {
-            return nlohmann::json{{"level", r.level},           {"cells", r.cells},
+            nlohmann::json j{{"level", r.level},           {"cells", r.cells},
                                   {"lacunas", r.lacunas},       {"r_limit", r.r_limit},
                                   {"cell_types", r.cell_types}, {"face_types", r.face_types},
                                   {"shared_faces", r.shared_faces}, {"pieces", r.pieces},
                                   {"volume_mm3", r.volume_mm3}};
+            if (r.tetrahedra) {
+              j["tetrahedra"] = r.tetrahedra;
+              j["cell_mm"] = {r.min_cell_mm, r.max_cell_mm};
+              j["max_delay"] = r.max_delay;
+              j["lacuna_mm"] = {r.min_lacuna_mm, r.max_lacuna_mm};
+            }
+            return j;
           },
       },
       report);

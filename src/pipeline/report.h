@@ -92,6 +92,12 @@ struct BcifsVolumeReport {
   size_t shared_faces = 0;  // faces two cells of the assembly share
   size_t pieces = 0;        // convex pieces handed to the rasterizer
   double volume_mm3 = 0;    // the cells' volume, exact (the solid is this less what the voxels round off)
+  // bcifs_infill only: the hull's tetrahedra, their sizes (edge of the regular tetrahedron of their volume)
+  // and the largest delay given to the small ones.
+  size_t tetrahedra = 0;
+  double min_cell_mm = 0, max_cell_mm = 0;
+  int max_delay = 0;
+  double min_lacuna_mm = 0, max_lacuna_mm = 0;  // per tetrahedron, its last level's lacunas (geometric mean)
 };
 
 // What building an input found; most inputs have nothing to report.

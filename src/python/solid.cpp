@@ -424,6 +424,10 @@ const char* kInputDocs[][2] = {
      "center_mm, delay, or corners_mm + faces, or cells (a list of those); walls (lacunar, plain), edge, params, "
      "algorithm, interior (lacunar, plain), radial, interior_params, interior_algorithm, level (2), lacuna_scale (0.5), "
      "face_lacuna_scale, gap_fraction, notch_depth."},
+    {"bcifs_infill",
+     "A hull filled with lacunar cells: hull (another input), skin_mm (1), cell_mm (10), level (2), equal_lacunas "
+     "(true), walls, edge, params, algorithm, interior, radial, interior_params, interior_algorithm, lacuna_scale, "
+     "face_lacuna_scale, gap_fraction, notch_depth."},
 };
 
 }  // namespace

@@ -27,6 +27,7 @@ VoronoiTilesInput parse_voronoi_tiles_input(const JsonObject& o);
 VoronoiFoamInput parse_voronoi_foam_input(const JsonObject& o);
 BcifsCellInput parse_bcifs_cell_input(const JsonObject& o);
 BcifsVolumeInput parse_bcifs_volume_input(const JsonObject& o);
+BcifsInfillInput parse_bcifs_infill_input(const JsonObject& o);
 
 // A `bcifs_plate` object: "face" {boundary, params, algorithm, delay, control_mm, bends_mm} or "faces" [...]
 // with "shared" [{face_a, edge_a, face_b, edge_b}], "level", "thickness_mm", "radius_mm" (a face without

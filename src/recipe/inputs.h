@@ -223,12 +223,26 @@ struct BcifsVolumeInput {
   size_t shared_faces = 0;
 };
 
+// "bcifs_infill": another input's hull, inset by a skin, divided into tetrahedra that conform to it (TetGen,
+// edges about cell_mm), every tetrahedron a lacunar cell, delayed by its size so that the lacunas have one size.
+struct BcifsInfillInput {
+  std::string hull;
+  double skin_mm = 1;
+  double cell_mm = 10;
+  int level = 2;
+  bool equal_lacunas = true;
+  bcifs::FaceType face;  // one edge in its boundary: the type of every edge
+  bool plain = false;
+  bcifs::InteriorFaces interior;
+  bcifs::VolumeGeometryOptions options;
+};
+
 // One input's options, by type.
 using InputSpec =
     std::variant<SphereInput, SpheresInput, CapsuleInput, TubesInput, BoxInput, CylinderInput, TorusInput, RegionInput,
                  MeshInput, SurfaceInput, LatticeInput, CifsInput, CurveInput, FillMotifsInput, FillSpheresInput,
                  VoronoiSpheresInput, VoronoiTilesInput, VoronoiFoamInput, BcifsPlateInput, BcifsCellInput,
-                 BcifsVolumeInput>;
+                 BcifsVolumeInput, BcifsInfillInput>;
 
 // The other inputs this one is built from (fit_to, cover), in no particular order.
 std::vector<std::string> dependencies(const InputSpec& spec);

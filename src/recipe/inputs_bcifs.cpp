@@ -241,21 +241,50 @@ CellSpec parse_volume_cell(const JsonObject& o, const FaceType& face, bool plain
 
 }  // namespace
 
-BcifsVolumeInput parse_bcifs_volume_input(const JsonObject& o) {
-  BcifsVolumeInput in;
-  const std::string faces = o.string_or("walls", "lacunar");
-  if (faces != "lacunar" && faces != "plain") o.fail("walls", "expected \"lacunar\" or \"plain\"");
-  FaceType face;
-  face.boundary = {parsed(o, "edge", "C2", parse_edge)};
-  face.edges = parsed(o, "params", "C2 B2 B2", parse_edge_set);
-  face.algorithm = parsed(o, "algorithm", "A1", parse_algorithm);
+namespace {
+
+// The keys a bcifs_volume and a bcifs_infill share: the walls' face rule, the interior faces, the geometry.
+struct VolumeKeys {
+  FaceType face;  // its boundary holds one edge: the type of every edge
+  bool plain = false;
+  InteriorFaces interior;
+  VolumeGeometryOptions options;
+  int level = 2;
+};
+
+VolumeKeys parse_volume_keys(const JsonObject& o, uint64_t max_level) {
+  VolumeKeys k;
+  const std::string walls = o.string_or("walls", "lacunar");
+  if (walls != "lacunar" && walls != "plain") o.fail("walls", "expected \"lacunar\" or \"plain\"");
+  k.plain = walls == "plain";
+  k.face.boundary = {parsed(o, "edge", "C2", parse_edge)};
+  k.face.edges = parsed(o, "params", "C2 B2 B2", parse_edge_set);
+  k.face.algorithm = parsed(o, "algorithm", "A1", parse_algorithm);
   const std::string interior = o.string_or("interior", "lacunar");
   if (interior != "lacunar" && interior != "plain") o.fail("interior", "expected \"lacunar\" or \"plain\"");
-  InteriorFaces& inner = in.spec.interior;
-  inner.plain = interior == "plain";
-  inner.radial = parsed(o, "radial", "B2", parse_edge);
-  inner.edges = o.has("interior_params") ? parsed(o, "interior_params", "", parse_edge_set) : face.edges;
-  inner.algorithm = o.has("interior_algorithm") ? parsed(o, "interior_algorithm", "", parse_algorithm) : face.algorithm;
+  k.interior.plain = interior == "plain";
+  k.interior.radial = parsed(o, "radial", "B2", parse_edge);
+  k.interior.edges = o.has("interior_params") ? parsed(o, "interior_params", "", parse_edge_set) : k.face.edges;
+  k.interior.algorithm =
+      o.has("interior_algorithm") ? parsed(o, "interior_algorithm", "", parse_algorithm) : k.face.algorithm;
+  const uint64_t level = o.unsigned_integer_or("level", 2);
+  if (level > max_level) o.fail("level", "expected a level from 0 to " + std::to_string(max_level));
+  k.level = int(level);
+  k.options.lacuna_scale = fraction(o, "lacuna_scale", k.options.lacuna_scale);
+  k.options.faces.lacuna_scale = fraction(o, "face_lacuna_scale", k.options.faces.lacuna_scale);
+  k.options.faces.gap_fraction = fraction(o, "gap_fraction", k.options.faces.gap_fraction);
+  k.options.faces.notch_depth = fraction(o, "notch_depth", k.options.faces.notch_depth);
+  return k;
+}
+
+}  // namespace
+
+BcifsVolumeInput parse_bcifs_volume_input(const JsonObject& o) {
+  BcifsVolumeInput in;
+  const VolumeKeys k = parse_volume_keys(o, 6);
+  in.spec.interior = k.interior;
+  in.level = k.level;
+  in.options = k.options;
   if (o.has("cells")) {
     if (o.has("cell") || o.has("edge_mm") || o.has("corners_mm") || o.has("delay"))
       o.fail("cells", "give the cells either as a list in \"cells\" or as one cell, not both");
@@ -264,23 +293,33 @@ BcifsVolumeInput parse_bcifs_volume_input(const JsonObject& o) {
     for (size_t i = 0; i < list.size(); ++i) {
       const JsonObject c(list[i], o.file(), o.path_of("cells") + "[" + std::to_string(i) + "]");
       c.allow_only({"cell", "edge_mm", "center_mm", "corners_mm", "faces", "delay"});
-      in.spec.cells.push_back(parse_volume_cell(c, face, faces == "plain"));
+      in.spec.cells.push_back(parse_volume_cell(c, k.face, k.plain));
     }
   } else {
-    in.spec.cells.push_back(parse_volume_cell(o, face, faces == "plain"));
+    in.spec.cells.push_back(parse_volume_cell(o, k.face, k.plain));
   }
   try {
     in.shared_faces = shared_faces(in.spec).size();
   } catch (const InvalidInput& e) {
     o.fail(o.has("cells") ? "cells" : "", e.what());
   }
-  const uint64_t level = o.unsigned_integer_or("level", 2);
-  if (level > 6) o.fail("level", "expected a level from 0 to 6");
-  in.level = int(level);
-  in.options.lacuna_scale = fraction(o, "lacuna_scale", in.options.lacuna_scale);
-  in.options.faces.lacuna_scale = fraction(o, "face_lacuna_scale", in.options.faces.lacuna_scale);
-  in.options.faces.gap_fraction = fraction(o, "gap_fraction", in.options.faces.gap_fraction);
-  in.options.faces.notch_depth = fraction(o, "notch_depth", in.options.faces.notch_depth);
+  return in;
+}
+
+BcifsInfillInput parse_bcifs_infill_input(const JsonObject& o) {
+  BcifsInfillInput in;
+  in.hull = o.string("hull");
+  const VolumeKeys k = parse_volume_keys(o, 4);
+  in.face = k.face;
+  in.plain = k.plain;
+  in.interior = k.interior;
+  in.options = k.options;
+  in.level = k.level;
+  if (in.level < 1) o.fail("level", "expected a level from 1 to 4");
+  in.skin_mm = o.number_or("skin_mm", 1.0);
+  if (!(in.skin_mm >= 0 && std::isfinite(in.skin_mm))) o.fail("skin_mm", "expected a skin of 0 mm or more");
+  in.cell_mm = o.positive_length_or("cell_mm", 10.0);
+  in.equal_lacunas = o.boolean_or("equal_lacunas", true);
   return in;
 }
 

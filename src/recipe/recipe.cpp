@@ -89,6 +89,11 @@ const std::map<std::string, InputType>& types() {
                "algorithm", "interior", "radial", "interior_params", "interior_algorithm", "level", "lacuna_scale",
                "face_lacuna_scale", "gap_fraction", "notch_depth"},
               parse_as<BcifsVolumeInput, parse_bcifs_volume_input>},
+             {"bcifs_infill",
+              {"hull", "skin_mm", "cell_mm", "equal_lacunas", "walls", "edge", "params", "algorithm", "interior",
+               "radial", "interior_params", "interior_algorithm", "level", "lacuna_scale", "face_lacuna_scale",
+               "gap_fraction", "notch_depth"},
+              parse_as<BcifsInfillInput, parse_bcifs_infill_input>},
          })
       t.emplace(type.type, type);
     return t;
@@ -487,6 +492,7 @@ std::vector<std::string> dependencies(const InputSpec& spec) {
                                                             : std::vector<std::string>{};
   if (const auto* foam = std::get_if<VoronoiFoamInput>(&spec))
     return foam->cover ? std::vector<std::string>{*foam->cover} : std::vector<std::string>{};
+  if (const auto* infill = std::get_if<BcifsInfillInput>(&spec)) return {infill->hull};
   return {};
 }
 

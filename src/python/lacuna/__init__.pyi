@@ -429,6 +429,26 @@ def bcifs_volume(
     gap_fraction: float = ...,
     notch_depth: float = ...,
 ) -> Solid: ...
+def bcifs_infill(
+    *,
+    hull: Solid,
+    skin_mm: float = ...,
+    cell_mm: float = ...,
+    level: int = ...,
+    equal_lacunas: bool = ...,
+    walls: Literal["lacunar", "plain"] = ...,
+    edge: str = ...,
+    params: str = ...,
+    algorithm: str = ...,
+    interior: Literal["lacunar", "plain"] = ...,
+    radial: str = ...,
+    interior_params: str = ...,
+    interior_algorithm: str = ...,
+    lacuna_scale: float = ...,
+    face_lacuna_scale: float = ...,
+    gap_fraction: float = ...,
+    notch_depth: float = ...,
+) -> Solid: ...
 
 # Generators.
 def cifs_library() -> List[str]: ...
