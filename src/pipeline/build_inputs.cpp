@@ -613,7 +613,9 @@ class Builder {
     const double h = b.cell_mm;
     VolumeOptions coarse;
     coarse.voxel_size_mm = std::max(vopt_.voxel_size_mm, h / 20);
-    coarse.half_band_voxels = (b.skin_mm + h) / coarse.voxel_size_mm + 3;
+    // A kept tetrahedron's outside corner lies within a cube's diagonal of an inside one: the band reaches that
+    // far past the inset, so every corner to move sees its true distance.
+    coarse.half_band_voxels = (b.skin_mm + h * std::sqrt(3.0)) / coarse.voxel_size_mm + 3;
     Volume inset = voxelize(geometry_of(b.hull), coarse);
     if (b.skin_mm > 0) inset = offset(inset, -b.skin_mm);
     if (inset.empty()) fail("skin_mm", "the hull is thinner than twice the skin: nothing is left to fill");
@@ -668,16 +670,19 @@ class Builder {
                       inset.distance_at(p + Vec3d{0, step, 0}) - inset.distance_at(p - Vec3d{0, step, 0}),
                       inset.distance_at(p + Vec3d{0, 0, step}) - inset.distance_at(p - Vec3d{0, 0, step})};
         const double g2 = dot(g, g) / (4 * step * step);
-        if (!(g2 > 0.25)) break;  // no clear direction (beyond the band): leave it
+        if (!(g2 > 0.25)) break;  // no clear direction (a ridge of the distance): leave it
         p = p - g * (d / (2 * step) / g2);
       }
       moved[v] = p;
+      // One that did not reach the surface (a ridge of the distance) would leave its cells sticking out.
+      if (inset.distance_at(p) > step) moves[v] = 2;
     }
     bcifs::VolumeSpec spec;
     spec.interior = b.interior;
     std::vector<double> sizes;
     const double regular = h * h * h / 6;  // a Kuhn tetrahedron's volume
     for (const auto& t : kept) {
+      if (moves[t[0]] == 2 || moves[t[1]] == 2 || moves[t[2]] == 2 || moves[t[3]] == 2) continue;
       bcifs::CellSpec c;
       for (size_t q : t) c.shape.corners_mm.push_back(moved[q]);
       const auto signed_volume = [](const std::vector<Vec3d>& p) {
