@@ -265,6 +265,55 @@ TEST(BcifsVolume, DelaysBySizeEqualizeTheLacunas) {
   EXPECT_LT(spread({1, shrink, shrink * shrink}, true), 1.5);
 }
 
+// A cell whose edges along `axis` are C2 and the others B2: its faces have mixed boundaries.
+CellSpec mixed_cell(const Polyhedron& shape, int axis) {
+  CellSpec c;
+  c.shape = shape;
+  for (const auto& loop : shape.faces) {
+    FaceType t{{}, parse_edge_set("B2 B2 B2"), Algorithm::kA1, 1};
+    for (size_t j = 0; j < loop.size(); ++j) {
+      const Vec3d d = shape.corners_mm[size_t(loop[(j + 1) % loop.size()])] - shape.corners_mm[size_t(loop[j])];
+      t.boundary.push_back(parse_edge(std::fabs(d[axis]) > 0 ? "C2" : "B2"));
+    }
+    c.face_types.push_back(t);
+    c.plain.push_back(0);
+  }
+  return c;
+}
+
+// Two cubes sharing the face x = 5, whose edges along y are C2 and along z B2: read backwards from the second
+// cube the face has the same edges, so it is shared; a second cube with the C2 edges along z sees the face's
+// edges swapped and is refused, naming both faces.
+TEST(BcifsVolume, SharedFacesWithMixedEdgesAreReadBackwards) {
+  VolumeSpec same;
+  same.cells.push_back(mixed_cell(regular_cell(CellKind::kHexahedron, 10), 1));
+  same.cells.push_back(mixed_cell(regular_cell(CellKind::kHexahedron, 10, {10, 0, 0}), 1));
+  const VolumeRules rules = build_volume_rules(same);
+  ASSERT_EQ(rules.shared.size(), 1u);
+  for (int k = 1; k <= 2; ++k) {
+    const VolumeLevel level = realize_volume(rules, same, k);
+    int on_plane = 0, twice = 0;
+    for (size_t f = 0; f < level.faces.size(); ++f) {
+      bool in = true;
+      for (const Vec3d& p : level.faces[f].polygon) in = in && std::fabs(p.x - 5) < 1e-9;
+      on_plane += in;
+      twice += in && level.owners[f] == 2;
+    }
+    EXPECT_GT(twice, 0);
+    EXPECT_EQ(on_plane, twice) << "level " << k;
+  }
+  VolumeSpec swapped = same;
+  swapped.cells[1] = mixed_cell(regular_cell(CellKind::kHexahedron, 10, {10, 0, 0}), 2);
+  try {
+    build_volume_rules(swapped);
+    ADD_FAILURE() << "a face seen with its edges swapped was shared";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("share a face but see different types"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("cell 0 face"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("cell 1 face"), std::string::npos) << e.what();
+  }
+}
+
 TEST(BcifsVolume, BadSpecsAreNamed) {
   auto message = [](const VolumeSpec& spec) {
     try {
@@ -291,6 +340,14 @@ TEST(BcifsVolume, BadSpecsAreNamed) {
   open.cells[0].face_types.pop_back();
   open.cells[0].plain.pop_back();
   EXPECT_NE(message(open).find("not closed"), std::string::npos) << message(open);
+
+  // An arrowhead (a quadrilateral with a reflex corner) extruded: closed, planar faces, outward, not convex.
+  Polyhedron arrow;
+  arrow.corners_mm = {{0, 0, 0}, {4, 2, 0}, {0, 4, 0}, {1, 2, 0}, {0, 0, 2}, {4, 2, 2}, {0, 4, 2}, {1, 2, 2}};
+  arrow.faces = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+  VolumeSpec dented;
+  dented.cells.push_back(uniform_cell(arrow, true));
+  EXPECT_NE(message(dented).find("not convex"), std::string::npos) << message(dented);
 
   VolumeSpec level;
   level.cells.push_back(uniform_cell(regular_cell(CellKind::kHexahedron, 10), false));

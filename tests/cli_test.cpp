@@ -718,7 +718,8 @@ TEST(Cli, BcifsRulesPlateAndMeasure) {
 }
 
 // `bcifs measure` of a bcifs_volume: the plain cube's 6^i cells and (1 - s^3)^i volumes, the lacunar cube's
-// tunnels; `run` reports the same exact volume; a bad cell and a face shared with different types are named.
+// tunnels; `run` reports the same exact volume; two cubes given by `cells` share their face; a bad cell name and
+// an inside-out cell are named.
 TEST(Cli, BcifsVolumeMeasureAndErrors) {
   TempDir dir;
   write_file(dir / "v.json", R"({"voxel_size_mm": 0.1, "inputs": {
@@ -756,7 +757,7 @@ TEST(Cli, BcifsVolumeMeasureAndErrors) {
   EXPECT_NE(bad.err.find("inputs.v.cell"), std::string::npos) << bad.err;
   EXPECT_NE(bad.err.find("dodecahedron"), std::string::npos) << bad.err;
   EXPECT_FALSE(fs::exists(dir / "bad"));
-  // Two cubes whose shared face is walked the same way by both (the second's corners listed mirrored).
+  // A second cube given by its corners and faces (the regular cube's corner order), beside the first.
   write_file(dir / "twice.json", R"({"voxel_size_mm": 0.1, "inputs": {
       "v": {"type": "bcifs_volume", "cells": [
         {"cell": "hexahedron", "edge_mm": 10},

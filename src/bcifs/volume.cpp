@@ -110,6 +110,17 @@ Vec3d corner_average(const std::vector<Vec3d>& points) {
 
 }  // namespace
 
+void set_uniform_faces(CellSpec& cell, const FaceType& face, bool plain) {
+  cell.face_types.clear();
+  cell.plain.clear();
+  for (const auto& loop : cell.shape.faces) {
+    FaceType t = face;
+    t.boundary.assign(loop.size(), face.boundary.at(0));
+    cell.face_types.push_back(t);
+    cell.plain.push_back(plain ? 1 : 0);
+  }
+}
+
 Polyhedron regular_cell(CellKind shape, double edge_mm, const Vec3d& center_mm) {
   Polyhedron p;
   std::map<PolygonKey, int> index;
@@ -196,6 +207,16 @@ std::vector<SharedFace> shared_faces(const VolumeSpec& spec) {
         volume += dot(pts[0] - shape.corners_mm[0], cross(pts[j] - shape.corners_mm[0], pts[j + 1] - shape.corners_mm[0]));
     }
     if (!(volume > 0)) throw InvalidInput(cn + ": its faces must run counter-clockwise seen from outside");
+    // Convex: every corner on the inner side of every face's plane (the rasterizer takes cells as convex, and the
+    // lacuna about the corners' average must stay inside).
+    for (size_t f = 0; f < shape.faces.size(); ++f) {
+      const std::vector<Vec3d> pts = face_points(shape, int(f));
+      const Vec3d n = newell(pts);
+      const Vec3d u = n / norm(n);
+      for (const Vec3d& p : shape.corners_mm)
+        if (dot(p - pts[0], u) > 1e-9 * (1 + size))
+          throw InvalidInput(cell_name(int(c), int(f)) + ": a corner lies outside the face's plane: the cell is not convex");
+    }
     // Faces shared with earlier cells.
     for (size_t f = 0; f < shape.faces.size(); ++f) {
       const std::vector<Vec3d> pts = face_points(shape, int(f));
@@ -390,6 +411,22 @@ double volume_cells(const VolumeRules& rules, int level) {
   return total;
 }
 
+double volume_lacunas(const VolumeRules& rules, int level) {
+  // L_0(t) = 0, L_i(t) = l(t) + sum over children of L_(i-1).
+  std::vector<double> l(rules.cells.size(), 0.0);
+  for (int i = 0; i < level; ++i) {
+    std::vector<double> next(rules.cells.size(), 0.0);
+    for (size_t t = 0; t < rules.cells.size(); ++t) {
+      next[t] = rules.cells[t].lacunas;
+      for (int child : rules.cells[t].children) next[t] += l[size_t(child)];
+    }
+    l.swap(next);
+  }
+  double total = 0;
+  for (int r : rules.roots) total += l[size_t(r)];
+  return total;
+}
+
 void validate(const VolumeGeometryOptions& options) {
   if (!(options.lacuna_scale > 0 && options.lacuna_scale < 1))
     throw InvalidInput("the cells' lacuna_scale must be in (0, 1), got " + std::to_string(options.lacuna_scale));
@@ -565,11 +602,11 @@ VolumeLevel realize_volume(const VolumeRules& rules, const VolumeSpec& spec, int
                            const VolumeGeometryOptions& options) {
   validate(options);
   if (levels < 0) throw InvalidInput("realize_volume: levels must be >= 0, got " + std::to_string(levels));
-  for (int i = 1; i <= levels; ++i)
-    if (volume_cells(rules, i) > kMaxVolumeCells)
-      throw ResourceLimit("level " + std::to_string(i) + " of the lacunar volume has " +
-                          std::to_string(int64_t(volume_cells(rules, i))) +
-                          " cells, more than 2 000 000; use a lower level");
+  // Cell counts never fall from one level to the next (every cell has a sub-cell): the last level decides.
+  if (volume_cells(rules, levels) > kMaxVolumeCells)
+    throw ResourceLimit("level " + std::to_string(levels) + " of the lacunar volume has " +
+                        message_number(volume_cells(rules, levels)) + " cells, more than " +
+                        message_number(kMaxVolumeCells) + "; use a lower level");
   Realizer realizer(rules, spec, options);
   VolumeLevel level = realizer.first();
   for (int i = 0; i < levels; ++i) level = realizer.next(level);
@@ -759,7 +796,9 @@ VolumeMeasures volume_measures(const VolumeRules& rules, const VolumeSpec& spec,
   validate(options);
   if (levels < 0) throw InvalidInput("volume_measures: levels must be >= 0, got " + std::to_string(levels));
   if (volume_cells(rules, levels) > kMaxVolumeCells)
-    throw ResourceLimit("level " + std::to_string(levels) + " of the lacunar volume has more than 2 000 000 cells");
+    throw ResourceLimit("level " + std::to_string(levels) + " of the lacunar volume has " +
+                        message_number(volume_cells(rules, levels)) + " cells, more than " +
+                        message_number(kMaxVolumeCells) + "; use a lower level");
   VolumeMeasures m;
   Realizer realizer(rules, spec, options);
   VolumeLevel level = realizer.first();

@@ -73,17 +73,21 @@ struct VolumeSpec {
   InteriorFaces interior;
 };
 
+// Gives every face of the cell the face type `face` with every edge of type face.boundary[0] (so neighbouring faces
+// agree on every edge), or makes every face plain.
+void set_uniform_faces(CellSpec& cell, const FaceType& face, bool plain);
+
 // Two cells with the same face (the same corners, in reverse order).
 struct SharedFace {
   int cell_a = -1, face_a = -1;
   int cell_b = -1, face_b = -1;
 };
 
-// The faces cells share, found by their corners. Throws InvalidInput naming the cells and faces when a face is
-// shared by more than two cells, when a cell's face is not planar or two cells overlap in part of a face only
-// (corners shared but not all), when the two sides of a shared face or of a cell's edge disagree on its type,
-// when a cell has fewer than 4 faces, a face fewer than 3 corners, or a face's type does not have one edge per
-// side.
+// The faces cells share, found by their corners (faces of two cells that overlap without the same corners are
+// not shared: each cell subdivides its own). Throws InvalidInput naming the cells and faces when a face is shared
+// by more than two cells, when a cell is not closed, not convex, inside out, or has a face that is not planar,
+// when the two sides of a shared face or of a cell's edge disagree on its type, when a cell has fewer than 4
+// faces, a face fewer than 3 corners, or a face's type does not have one edge per side.
 std::vector<SharedFace> shared_faces(const VolumeSpec& spec);
 
 // A face of a cell type: its face-type id, or -1 with its number of sides for a plain face.
@@ -102,7 +106,7 @@ struct CellType {
 
 struct CellRule {
   CellType cell;
-  std::vector<int> children;  // one cell-type id per sub-cell, in the order realize_volume makes them
+  std::vector<int> children;  // one cell-type id per sub-cell (a multiset: the order of the sorted face slots)
   double lacunas = 0;         // N^L_1: 1, or 0 for a delayed cell
 };
 
@@ -129,6 +133,8 @@ Lacunarity volume_lacunarity(const VolumeRules& rules, int type, int levels);
 
 // Sub-cells of the whole assembly at `level` (the sum over its cells), without realizing them.
 double volume_cells(const VolumeRules& rules, int level);
+// Lacunas (N^L) of the whole assembly at `level`, likewise.
+double volume_lacunas(const VolumeRules& rules, int level);
 
 struct VolumeGeometryOptions {
   double lacuna_scale = 0.5;  // the cell's lacuna: the cell scaled about its apex, in (0, 1)
@@ -182,9 +188,9 @@ double cell_volume(const VolumeLevel& level, const VolumeCell& cell, const Volum
 // no crack where the face lies on a voxel plane.
 std::vector<ConvexCells> convex_pieces(const VolumeLevel& level, const VolumeSpec& spec);
 
-// How much one level shrinks a cell: the geometric mean of cbrt(volume) over its level-1 sub-cells divided by that
-// over its level-2 sub-cells, for cell `cell` of the spec subdivided alone without delay (about 3.4 for a cube or
-// a tetrahedron with Bezier B2 walls and lacuna scale 0.5).
+// How much one level shrinks a cell: the geometric mean of cbrt(volume) over its level-1 sub-cells divided by
+// that over its level-2 sub-cells, for cell `cell` of the spec subdivided alone without delay (between 3 and 4
+// for a cube or a tetrahedron with Bezier B2 walls and lacuna scale 0.5).
 double level_shrink(const VolumeSpec& spec, int cell, const VolumeGeometryOptions& options = {});
 
 // Delays that give cells of different sizes lacunas of about one size: a cell of size L waits
@@ -202,7 +208,9 @@ std::vector<double> last_lacuna_sizes(const VolumeRules& rules, const VolumeSpec
 
 struct VolumeMeasures {
   std::vector<double> volume;   // V_i, i = 0..levels: the cells' volumes summed
-  std::vector<double> surface;  // S_i: the area of the faces only one cell has (the union's boundary)
+  std::vector<double> surface;  // S_i: the area of the faces only one cell has (the union's boundary where
+                                // neighbours subdivide shared faces alike; an upper bound where a plain face
+                                // meets a lacunar one, whose sub-cells' sides split the edge the plain one keeps)
   double volume_factor = 0;     // F_V = (V_levels / V_0)^(1 / levels)
   double surface_factor = 0;    // F_S likewise
   // Tunnels made from level i - 1 to i: every face object of level i - 1 that its cells subdivide with a central

@@ -99,6 +99,8 @@ int bcifs_measure(const BcifsArgs& a) {
         m = measure_volume(input.spec, input.options, hi);
       } catch (const InvalidInput& e) {
         throw InvalidInput(a.recipe + ": " + path + ": " + e.what());
+      } catch (const ResourceLimit& e) {
+        throw ResourceLimit(a.recipe + ": " + path + ": " + e.what());
       }
       nlohmann::json cells = nlohmann::json::array();
       for (size_t c = 0; c < m.cells.size(); ++c) {

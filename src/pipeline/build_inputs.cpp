@@ -582,16 +582,14 @@ class Builder {
     }
     const double cells = bcifs::volume_cells(rules, v.level);
     if (cells > bcifs::kMaxVolumeCells)
-      throw ResourceLimit(where() + ".level: level " + std::to_string(v.level) + " has " +
-                          std::to_string(int64_t(cells)) + " cells, more than " +
-                          std::to_string(int64_t(bcifs::kMaxVolumeCells)) + "; use a lower level");
+      throw ResourceLimit(where() + ".level: level " + std::to_string(v.level) + " has " + message_number(cells) +
+                          " cells, more than " + message_number(bcifs::kMaxVolumeCells) + "; use a lower level");
     const bcifs::VolumeLevel level = bcifs::realize_volume(rules, v.spec, v.level, v.options);
     BcifsVolumeReport report;
     report.level = v.level;
     report.cells = level.cells.size();
-    const bcifs::Lacunarity l = bcifs::volume_lacunarity(rules, rules.roots[0], v.level);
-    for (int root : rules.roots) report.lacunas += bcifs::volume_lacunarity(rules, root, v.level).lacunas.back();
-    report.r_limit = l.limit;
+    report.lacunas = bcifs::volume_lacunas(rules, v.level);
+    report.r_limit = bcifs::volume_lacunarity(rules, rules.roots[0], v.level).limit;
     report.cell_types = rules.cells.size();
     report.face_types = rules.faces.rules.size();
     report.shared_faces = rules.shared.size();
@@ -658,6 +656,11 @@ class Builder {
             for (size_t q : c)
               if (distance[q] >= 0) moves[q] = 1;
           }
+    // Every tetrahedron makes at least one cell at every level: refuse before building millions of them.
+    if (double(kept.size()) > bcifs::kMaxVolumeCells)
+      throw ResourceLimit(where() + ".cell_mm: cells of " + message_number(h) + " mm make " +
+                          message_number(double(kept.size())) + " tetrahedra in the hull, more than " +
+                          message_number(bcifs::kMaxVolumeCells) + "; use larger cells");
     // Outside corners onto the inset surface: Newton steps along the distance's gradient.
     const double step = coarse.voxel_size_mm;
     std::vector<Vec3d> moved = point;
@@ -697,12 +700,7 @@ class Builder {
       // Positively oriented (corner 3 on the side the normal of 0, 1, 2 points to): these run outward.
       c.shape.faces = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}};
       sizes.push_back(std::cbrt(6 * std::sqrt(2.0) * std::fabs(now)));  // the edge of a regular tetrahedron that large
-      for (int f = 0; f < 4; ++f) {
-        bcifs::FaceType t3 = b.face;
-        t3.boundary.assign(3, b.face.boundary[0]);
-        c.face_types.push_back(t3);
-        c.plain.push_back(b.plain ? 1 : 0);
-      }
+      bcifs::set_uniform_faces(c, b.face, b.plain);
       spec.cells.push_back(std::move(c));
     }
     if (spec.cells.empty()) fail("cell_mm", "the inset hull holds no cell");
@@ -724,14 +722,13 @@ class Builder {
     const double cells = bcifs::volume_cells(rules, b.level);
     if (cells > bcifs::kMaxVolumeCells)
       throw ResourceLimit(where() + ": " + std::to_string(spec.cells.size()) + " tetrahedra at level " +
-                          std::to_string(b.level) + " make " + std::to_string(int64_t(cells)) +
-                          " cells, more than " + std::to_string(int64_t(bcifs::kMaxVolumeCells)) +
-                          "; use larger cell_mm or a lower level");
+                          std::to_string(b.level) + " make " + message_number(cells) + " cells, more than " +
+                          message_number(bcifs::kMaxVolumeCells) + "; use larger cell_mm or a lower level");
     const bcifs::VolumeLevel level = bcifs::realize_volume(rules, spec, b.level, b.options);
     BcifsVolumeReport report;
     report.level = b.level;
     report.cells = level.cells.size();
-    for (int root : rules.roots) report.lacunas += bcifs::volume_lacunarity(rules, root, b.level).lacunas.back();
+    report.lacunas = bcifs::volume_lacunas(rules, b.level);
     report.cell_types = rules.cells.size();
     report.face_types = rules.faces.rules.size();
     report.shared_faces = rules.shared.size();

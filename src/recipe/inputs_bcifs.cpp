@@ -230,12 +230,7 @@ CellSpec parse_volume_cell(const JsonObject& o, const FaceType& face, bool plain
   const uint64_t delay = o.unsigned_integer_or("delay", 1);
   if (delay < 1 || delay > 8) o.fail("delay", "expected a delay from 1 to 8");
   cell.delay = int(delay);
-  for (const auto& loop : cell.shape.faces) {
-    FaceType t = face;
-    t.boundary.assign(loop.size(), face.boundary[0]);
-    cell.face_types.push_back(t);
-    cell.plain.push_back(plain ? 1 : 0);
-  }
+  set_uniform_faces(cell, face, plain);
   return cell;
 }
 
