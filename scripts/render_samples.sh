@@ -8,7 +8,8 @@ build="${1:-build}"
 mkdir -p samples/pictures
 # Parts whose structure is inside a skin are shown cut at half their height.
 for entry in menger_sponge takagi_nurbs_shell lacunar_hexagon_plate lacunar_cell hilbert_sphere sierpinski_torus \
-             voronoi_foam:0.5 porous_egg:0.5 lacunar_panel egg_infill:0.5 lattice_block; do
+             voronoi_foam:0.5 porous_egg:0.5 lacunar_panel egg_infill:0.5 lattice_block lacunar_hexahedron:0.5 \
+             lacunar_egg:0.5; do
   s="${entry%%:*}"
   args=()
   [ "$entry" != "$s" ] && args=(--section "${entry#*:}")
