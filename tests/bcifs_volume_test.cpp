@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "bcifs/realize.h"
@@ -48,6 +49,18 @@ VolumeSpec plain_spec(CellKind kind, double edge) {
 
 // convex_pieces grows every piece by a relative 1e-9: its volume by (1 + 1e-9)^3.
 const double kGrown = std::pow(1 + 1e-9, 3);
+
+// Faces of a level lying in the plane x = `x`, and how many of them two cells have.
+std::pair<int, int> faces_on_plane(const VolumeLevel& level, double x) {
+  int on_plane = 0, twice = 0;
+  for (size_t f = 0; f < level.faces.size(); ++f) {
+    bool in = true;
+    for (const Vec3d& p : level.faces[f].polygon) in = in && std::fabs(p.x - x) < 1e-9;
+    on_plane += in;
+    twice += in && level.owners[f] == 2;
+  }
+  return {on_plane, twice};
+}
 
 double total_volume(const VolumeLevel& level, const VolumeSpec& spec) {
   double v = 0;
@@ -223,14 +236,7 @@ TEST(BcifsVolume, AssemblyOfMixedCellsAndDelaysSharesItsFaceAtEveryLevel) {
   EXPECT_EQ(face.subfaces[1], 1);
   for (int k = 1; k <= 4; ++k) {
     const VolumeLevel level = realize_volume(rules, spec, k);
-    int on_plane = 0, twice = 0;
-    for (size_t f = 0; f < level.faces.size(); ++f) {
-      bool in = true;
-      for (const Vec3d& p : level.faces[f].polygon) in = in && std::fabs(p.x - 5) < 1e-9;
-      if (!in) continue;
-      ++on_plane;
-      twice += level.owners[f] == 2;
-    }
+    const auto [on_plane, twice] = faces_on_plane(level, 5);
     EXPECT_EQ(on_plane, twice) << "level " << k;
     EXPECT_EQ(double(twice), face.subfaces[size_t(k)]) << "level " << k;
     EXPECT_EQ(double(level.cells.size()), volume_cells(rules, k)) << "level " << k;
@@ -291,14 +297,7 @@ TEST(BcifsVolume, SharedFacesWithMixedEdgesAreReadBackwards) {
   const VolumeRules rules = build_volume_rules(same);
   ASSERT_EQ(rules.shared.size(), 1u);
   for (int k = 1; k <= 2; ++k) {
-    const VolumeLevel level = realize_volume(rules, same, k);
-    int on_plane = 0, twice = 0;
-    for (size_t f = 0; f < level.faces.size(); ++f) {
-      bool in = true;
-      for (const Vec3d& p : level.faces[f].polygon) in = in && std::fabs(p.x - 5) < 1e-9;
-      on_plane += in;
-      twice += in && level.owners[f] == 2;
-    }
+    const auto [on_plane, twice] = faces_on_plane(realize_volume(rules, same, k), 5);
     EXPECT_GT(twice, 0);
     EXPECT_EQ(on_plane, twice) << "level " << k;
   }

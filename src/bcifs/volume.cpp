@@ -596,17 +596,21 @@ class Realizer {
   std::map<EdgeType, std::pair<int, int>> quads_;
 };
 
+// Cell counts never fall from one level to the next (every cell has a sub-cell): the last level decides.
+void check_cell_count(const VolumeRules& rules, int levels) {
+  const double cells = volume_cells(rules, levels);
+  if (cells > kMaxVolumeCells)
+    throw ResourceLimit("level " + std::to_string(levels) + " of the lacunar volume has " + message_number(cells) +
+                        " cells, more than " + message_number(kMaxVolumeCells) + "; use a lower level");
+}
+
 }  // namespace
 
 VolumeLevel realize_volume(const VolumeRules& rules, const VolumeSpec& spec, int levels,
                            const VolumeGeometryOptions& options) {
   validate(options);
   if (levels < 0) throw InvalidInput("realize_volume: levels must be >= 0, got " + std::to_string(levels));
-  // Cell counts never fall from one level to the next (every cell has a sub-cell): the last level decides.
-  if (volume_cells(rules, levels) > kMaxVolumeCells)
-    throw ResourceLimit("level " + std::to_string(levels) + " of the lacunar volume has " +
-                        message_number(volume_cells(rules, levels)) + " cells, more than " +
-                        message_number(kMaxVolumeCells) + "; use a lower level");
+  check_cell_count(rules, levels);
   Realizer realizer(rules, spec, options);
   VolumeLevel level = realizer.first();
   for (int i = 0; i < levels; ++i) level = realizer.next(level);
@@ -795,10 +799,7 @@ VolumeMeasures volume_measures(const VolumeRules& rules, const VolumeSpec& spec,
                                const VolumeGeometryOptions& options) {
   validate(options);
   if (levels < 0) throw InvalidInput("volume_measures: levels must be >= 0, got " + std::to_string(levels));
-  if (volume_cells(rules, levels) > kMaxVolumeCells)
-    throw ResourceLimit("level " + std::to_string(levels) + " of the lacunar volume has " +
-                        message_number(volume_cells(rules, levels)) + " cells, more than " +
-                        message_number(kMaxVolumeCells) + "; use a lower level");
+  check_cell_count(rules, levels);
   VolumeMeasures m;
   Realizer realizer(rules, spec, options);
   VolumeLevel level = realizer.first();

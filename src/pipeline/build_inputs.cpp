@@ -572,33 +572,43 @@ class Builder {
 
   // Cells subdivided in 3D: the level's sub-cells as convex pieces (lacunas and tunnels are what is left out).
   void add(const BcifsVolumeInput& v) {
-    bcifs::VolumeRules rules;
+    const bcifs::VolumeRules rules = volume_rules(v.spec);
+    const double cells = bcifs::volume_cells(rules, v.level);
+    if (cells > bcifs::kMaxVolumeCells)
+      throw ResourceLimit(where() + ".level: level " + std::to_string(v.level) + " has " + message_number(cells) +
+                          " cells, more than " + message_number(bcifs::kMaxVolumeCells) + "; use a lower level");
+    BcifsVolumeReport report;
+    report.r_limit = bcifs::volume_lacunarity(rules, rules.roots[0], v.level).limit;
+    add_cells(rules, v.spec, v.level, v.options, report);
+    out_.report = report;
+  }
+
+  // The rules of a volume's cells; their errors name this input.
+  bcifs::VolumeRules volume_rules(const bcifs::VolumeSpec& spec) const {
     try {
-      rules = bcifs::build_volume_rules(v.spec);
+      return bcifs::build_volume_rules(spec);
     } catch (const InvalidInput& e) {
       fail("", e.what());
     } catch (const ResourceLimit& e) {
       throw ResourceLimit(where() + ": " + e.what());
     }
-    const double cells = bcifs::volume_cells(rules, v.level);
-    if (cells > bcifs::kMaxVolumeCells)
-      throw ResourceLimit(where() + ".level: level " + std::to_string(v.level) + " has " + message_number(cells) +
-                          " cells, more than " + message_number(bcifs::kMaxVolumeCells) + "; use a lower level");
-    const bcifs::VolumeLevel level = bcifs::realize_volume(rules, v.spec, v.level, v.options);
-    BcifsVolumeReport report;
-    report.level = v.level;
-    report.cells = level.cells.size();
-    report.lacunas = bcifs::volume_lacunas(rules, v.level);
-    report.r_limit = bcifs::volume_lacunarity(rules, rules.roots[0], v.level).limit;
+  }
+
+  // The cells realized at `level` into this input's geometry as convex pieces, and their counts in the report.
+  void add_cells(const bcifs::VolumeRules& rules, const bcifs::VolumeSpec& spec, int level,
+                 const bcifs::VolumeGeometryOptions& options, BcifsVolumeReport& report) {
+    const bcifs::VolumeLevel cells = bcifs::realize_volume(rules, spec, level, options);
+    report.level = level;
+    report.cells = cells.cells.size();
+    report.lacunas = bcifs::volume_lacunas(rules, level);
     report.cell_types = rules.cells.size();
     report.face_types = rules.faces.rules.size();
     report.shared_faces = rules.shared.size();
-    for (const bcifs::VolumeCell& c : level.cells) report.volume_mm3 += bcifs::cell_volume(level, c, v.spec);
-    for (ConvexCells& pieces : bcifs::convex_pieces(level, v.spec)) {
+    for (const bcifs::VolumeCell& c : cells.cells) report.volume_mm3 += bcifs::cell_volume(cells, c, spec);
+    for (ConvexCells& pieces : bcifs::convex_pieces(cells, spec)) {
       report.pieces += pieces.size();
       out_.geometry.cells.push_back(std::move(pieces));
     }
-    out_.report = report;
   }
 
   // A hull filled with lacunar cells: a grid of cubes of cell_mm, each split into six tetrahedra around its
@@ -711,27 +721,14 @@ class Builder {
       const std::vector<int> delays = bcifs::delays_for_sizes(sizes, b.level, shrink);
       for (size_t c = 0; c < spec.cells.size(); ++c) spec.cells[c].delay = delays[c];
     }
-    bcifs::VolumeRules rules;
-    try {
-      rules = bcifs::build_volume_rules(spec);
-    } catch (const InvalidInput& e) {
-      fail("", e.what());
-    } catch (const ResourceLimit& e) {
-      throw ResourceLimit(where() + ": " + e.what());
-    }
+    const bcifs::VolumeRules rules = volume_rules(spec);
     const double cells = bcifs::volume_cells(rules, b.level);
     if (cells > bcifs::kMaxVolumeCells)
       throw ResourceLimit(where() + ": " + std::to_string(spec.cells.size()) + " tetrahedra at level " +
                           std::to_string(b.level) + " make " + message_number(cells) + " cells, more than " +
                           message_number(bcifs::kMaxVolumeCells) + "; use larger cell_mm or a lower level");
-    const bcifs::VolumeLevel level = bcifs::realize_volume(rules, spec, b.level, b.options);
     BcifsVolumeReport report;
-    report.level = b.level;
-    report.cells = level.cells.size();
-    report.lacunas = bcifs::volume_lacunas(rules, b.level);
-    report.cell_types = rules.cells.size();
-    report.face_types = rules.faces.rules.size();
-    report.shared_faces = rules.shared.size();
+    add_cells(rules, spec, b.level, b.options, report);
     report.tetrahedra = spec.cells.size();
     report.min_cell_mm = *std::min_element(sizes.begin(), sizes.end());
     report.max_cell_mm = *std::max_element(sizes.begin(), sizes.end());
@@ -744,11 +741,6 @@ class Builder {
         report.max_lacuna_mm = std::max(report.max_lacuna_mm, l);
       }
     if (!(report.max_lacuna_mm > 0)) report.min_lacuna_mm = 0;
-    for (const bcifs::VolumeCell& c : level.cells) report.volume_mm3 += bcifs::cell_volume(level, c, spec);
-    for (ConvexCells& pieces : bcifs::convex_pieces(level, spec)) {
-      report.pieces += pieces.size();
-      out_.geometry.cells.push_back(std::move(pieces));
-    }
     out_.report = report;
   }
 
