@@ -4,7 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -269,6 +271,150 @@ TEST(BcifsVolume, DelaysBySizeEqualizeTheLacunas) {
   EXPECT_NEAR(spread({1, 2, 4}, true), 2, 0.05);
   EXPECT_EQ(delays_for_sizes({1, shrink, shrink * shrink}, 3, shrink), (std::vector<int>{3, 2, 1}));
   EXPECT_LT(spread({1, shrink, shrink * shrink}, true), 1.5);
+}
+
+// Cells of edges varying 4x, with plain walls (each subdivision leaves a cell's lacuna exactly its region scaled,
+// and its sub-cells fill the rest): each lacuna the last level makes is measured from the volumes alone, as the
+// cube root of its parent's volume less its sub-cells' (found by their apex: the parent's centre), and averaged
+// geometrically per cell of the spec. Delays by size leave them more than 1.5 apart; the last lacuna scales bring
+// them within 1.5.
+TEST(BcifsVolume, LastLacunaScalesBringLacunasOfCellsVarying4xWithin1_5) {
+  const std::vector<double> edges{1, 1.6, 2.5, 4};
+  const int level = 3;
+  VolumeSpec spec;
+  for (size_t c = 0; c < edges.size(); ++c)
+    spec.cells.push_back(uniform_cell(regular_cell(CellKind::kHexahedron, edges[c], {10.0 * double(c), 0, 0}), true));
+  spec.interior.plain = true;
+  const double shrink = level_shrink(spec, 3);
+  EXPECT_GT(shrink, 1.5);
+  const std::vector<int> delays = delays_for_sizes(edges, level, shrink);
+  for (size_t c = 0; c < edges.size(); ++c) spec.cells[c].delay = delays[c];
+  const VolumeRules rules = build_volume_rules(spec);
+  auto measured = [&](const VolumeGeometryOptions& options) {
+    VolumeGeometryOptions common = options;  // the last scales belong to the last subdivision only
+    common.last_lacuna_scale.clear();
+    const VolumeLevel before = realize_volume(rules, spec, level - 1, common);
+    const VolumeLevel after = realize_volume(rules, spec, level, options);
+    std::map<std::array<double, 3>, double> filled;  // by apex: the sub-cells' volume
+    for (const VolumeCell& cell : after.cells)
+      if (cell.root < 0) filled[{cell.base_apex.x, cell.base_apex.y, cell.base_apex.z}] += cell_volume(after, cell, spec);
+    std::vector<double> log_sum(edges.size(), 0.0), count(edges.size(), 0.0);
+    for (const VolumeCell& cell : before.cells) {
+      if (cell.delay != 1) continue;
+      const double lacuna = cell_volume(before, cell, spec) - filled.at({cell.apex.x, cell.apex.y, cell.apex.z});
+      log_sum[size_t(cell.origin)] += std::log(std::cbrt(lacuna));
+      count[size_t(cell.origin)] += 1;
+    }
+    std::vector<double> sizes;
+    for (size_t c = 0; c < edges.size(); ++c) sizes.push_back(std::exp(log_sum[c] / count[c]));
+    return *std::max_element(sizes.begin(), sizes.end()) / *std::min_element(sizes.begin(), sizes.end());
+  };
+  VolumeGeometryOptions options;
+  const double delayed_only = measured(options);
+  EXPECT_GT(delayed_only, 1.5);
+  options.last_lacuna_scale = lacuna_scales_for_sizes(last_lacuna_sizes(rules, spec, level, options), 0.5);
+  for (double s : options.last_lacuna_scale) {
+    EXPECT_GE(s, 0.5 / 3);
+    EXPECT_LE(s, 0.5);
+  }
+  EXPECT_LT(measured(options), 1.5);
+  // last_lacuna_sizes reads the scales too: one size for all (none clamped here).
+  const std::vector<double> sizes = last_lacuna_sizes(rules, spec, level, options);
+  EXPECT_NEAR(*std::max_element(sizes.begin(), sizes.end()) / *std::min_element(sizes.begin(), sizes.end()), 1, 1e-9);
+  // The same with lacunar (B2) walls: the lacunas' sizes as last_lacuna_sizes reads them.
+  VolumeSpec walls = spec;
+  for (CellSpec& c : walls.cells) c = [&] {
+      CellSpec w = uniform_cell(c.shape, false);
+      w.delay = c.delay;
+      return w;
+    }();
+  walls.interior = InteriorFaces{};
+  const VolumeRules wall_rules = build_volume_rules(walls);
+  VolumeGeometryOptions equal;
+  const std::vector<double> before = last_lacuna_sizes(wall_rules, walls, level, equal);
+  equal.last_lacuna_scale = lacuna_scales_for_sizes(before, 0.5);
+  const std::vector<double> after = last_lacuna_sizes(wall_rules, walls, level, equal);
+  EXPECT_LT(*std::max_element(after.begin(), after.end()) / *std::min_element(after.begin(), after.end()), 1.5);
+}
+
+// Two cubes sharing the face x = 5 with last lacuna scales 0.3 and 0.7: the shared face's sub-faces are still one
+// set, owned by both cubes' cells, and each cube keeps its own volume (1 - s^3) per plain level.
+TEST(BcifsVolume, LastLacunaScalesKeepSharedFacesShared) {
+  VolumeSpec spec;
+  spec.cells.push_back(uniform_cell(regular_cell(CellKind::kHexahedron, 5, {2.5, 2.5, 2.5}), false));
+  spec.cells.push_back(uniform_cell(regular_cell(CellKind::kHexahedron, 5, {7.5, 2.5, 2.5}), false));
+  const VolumeRules rules = build_volume_rules(spec);
+  VolumeGeometryOptions same, own;
+  own.last_lacuna_scale = {0.3, 0.7};
+  for (int level = 1; level <= 2; ++level) {
+    const auto [on_plane, twice] = faces_on_plane(realize_volume(rules, spec, level, own), 5.0);
+    EXPECT_EQ(faces_on_plane(realize_volume(rules, spec, level, same), 5.0), std::make_pair(on_plane, twice));
+    EXPECT_GT(twice, 0);
+    EXPECT_EQ(on_plane, twice);
+  }
+  VolumeSpec plain = plain_spec(CellKind::kHexahedron, 2);
+  const VolumeRules plain_rules = build_volume_rules(plain);
+  VolumeGeometryOptions last;
+  last.last_lacuna_scale = {0.3};
+  EXPECT_NEAR(total_volume(realize_volume(plain_rules, plain, 2, last), plain), 8 * (1 - 0.125) * (1 - 0.027), 1e-9);
+  last.last_lacuna_scale = {0.3, 0.4};
+  EXPECT_THROW(realize_volume(plain_rules, plain, 2, last), InvalidInput);
+  last.last_lacuna_scale = {1.0};
+  EXPECT_THROW(realize_volume(plain_rules, plain, 2, last), InvalidInput);
+}
+
+// A plain cube sampled: at level 0 the voxel centres inside are those within the cube along each axis (the grid
+// has a margin), at level 1 less those within its lacuna (the middle half along each axis); box counts of a grid
+// the cube fills are N_eps = (1/eps)^3 (dimension 3) and for its boundary the shell b^3 - (b - 2)^3; the middle
+// section is the square's pixels less the lacuna's, counted the same way.
+TEST(BcifsVolume, VoxelMasksBoxCountsAndSectionsOfACube) {
+  const VolumeSpec spec = plain_spec(CellKind::kHexahedron, 2);
+  const VolumeRules rules = build_volume_rules(spec);
+  const std::vector<ConvexCells> whole = convex_pieces(realize_volume(rules, spec, 0), spec);
+  const std::vector<ConvexCells> opened = convex_pieces(realize_volume(rules, spec, 1), spec);
+  // Centres origin + (i + 1/2) step, 0 <= i < n, within [lo, hi].
+  auto centres = [](double origin, double step, int n, double lo, double hi) {
+    int count = 0;
+    for (int i = 0; i < n; ++i) count += origin + (i + 0.5) * step >= lo && origin + (i + 0.5) * step <= hi;
+    return count;
+  };
+  auto mask_of = [](const std::vector<ConvexCells>& pieces, const VoxelGrid& grid) {
+    const size_t n = size_t(grid.size);
+    std::vector<uint8_t> mask(n * n * n);
+    // In two calls, as callers do in parallel.
+    mark_voxels(pieces, grid, 0, grid.size / 2, mask.data());
+    mark_voxels(pieces, grid, grid.size / 2, grid.size, mask.data() + n * n * n / 2);
+    return mask;
+  };
+  const VoxelGrid grid = voxel_grid(opened, 64);
+  EXPECT_NEAR(grid.origin_mm.x, -1 - 2 * std::sqrt(2.0) / 128, 1e-8);
+  EXPECT_NEAR(grid.voxel_mm * 64, 2 + 4 * std::sqrt(2.0) / 128, 1e-8);
+  const int inside = centres(grid.origin_mm.x, grid.voxel_mm, 64, -1, 1);
+  const int lacuna = centres(grid.origin_mm.x, grid.voxel_mm, 64, -0.5, 0.5);
+  EXPECT_GT(inside, 60);
+  EXPECT_GT(lacuna, 30);
+  const std::vector<uint8_t> full = mask_of(whole, grid), hollow = mask_of(opened, grid);
+  EXPECT_EQ(std::count(full.begin(), full.end(), 1), inside * inside * inside);
+  EXPECT_EQ(std::count(hollow.begin(), hollow.end(), 1), inside * inside * inside - lacuna * lacuna * lacuna);
+  const std::vector<uint8_t> ones(16 * 16 * 16, 1);
+  const BoxCount region = box_count_3d(ones, 16, false), shell = box_count_3d(ones, 16, true);
+  ASSERT_EQ(region.log_count.size(), 3u);
+  for (size_t i = 0; i < 3; ++i) {
+    const double b = std::exp(region.log_inverse_size[i]);
+    EXPECT_NEAR(b, 4.0 * double(1 << i), 1e-9);
+    EXPECT_NEAR(region.log_count[i], 3 * std::log(b), 1e-12);
+    EXPECT_NEAR(shell.log_count[i], std::log(b * b * b - (b - 2) * (b - 2) * (b - 2)), 1e-12);
+  }
+  EXPECT_NEAR(region.dimension, 3, 1e-12);
+  const double pixel = grid.voxel_mm * 64 / 1024;
+  const int square = centres(grid.origin_mm.x, pixel, 1024, -1, 1), hole = centres(grid.origin_mm.x, pixel, 1024, -0.5, 0.5);
+  for (int axis = 0; axis < 3; ++axis) {
+    const std::vector<uint8_t> section = section_mask(opened, grid, axis, 0.0, 1024);
+    EXPECT_EQ(std::count(section.begin(), section.end(), 1), square * square - hole * hole) << axis;
+  }
+  EXPECT_THROW(voxel_grid(opened, 48), InvalidInput);
+  EXPECT_THROW(box_count_3d(hollow, 32, false), InvalidInput);
+  EXPECT_THROW(section_mask(opened, grid, 3, 0.0, 64), InvalidInput);
 }
 
 // A cell whose edges along `axis` are C2 and the others B2: its faces have mixed boundaries.

@@ -499,6 +499,15 @@ std::vector<BadCase> bad_cases() {
       {"fill_motifs_bad_polygon", with_input(R"({"type": "fill_motifs", "motif": {"polygon": [[0, 0], [1, 1], [1, 0], [0, 1]]}, "height_mm": 1, "region": {"disk": {"radius_mm": 5}}})"), "", "", "inputs.x.motif"},
       {"fill_spheres_two_regions", with_input(R"({"type": "fill_spheres", "box": {"min_mm": [0,0,0], "max_mm": [5,5,5]}, "sphere": {"radius_mm": 3}})"), "", "", "one region"},
       {"fill_spheres_bad_motif", with_input(R"({"type": "fill_spheres", "motif": "dodecahedron", "sphere": {"radius_mm": 3}})"), "", "", "inputs.x.motif"},
+      {"bcifs_infill_grade_levels", R"({"inputs": {"h": {"type": "sphere", "radius_mm": 8}, "x": {"type": "bcifs_infill",
+          "hull": "h", "level": 2, "grade": {"field": "ramp", "from_mm": 0, "to_mm": 1, "levels": 2}}},
+          "outputs": [{"of": "x", "file": "x.stl"}]})", "", "", "inputs.x.grade.levels"},
+      {"bcifs_infill_grade_level_1", R"({"inputs": {"h": {"type": "sphere", "radius_mm": 8}, "x": {"type": "bcifs_infill",
+          "hull": "h", "level": 1, "grade": {"field": "depth", "depth_mm": 2}}},
+          "outputs": [{"of": "x", "file": "x.stl"}]})", "", "", "level 2 or more"},
+      {"bcifs_infill_grade_field", R"({"inputs": {"h": {"type": "sphere", "radius_mm": 8}, "x": {"type": "bcifs_infill",
+          "hull": "h", "grade": {"field": "noise"}}}, "outputs": [{"of": "x", "file": "x.stl"}]})", "", "",
+       "inputs.x.grade.field"},
       {"empty_result", R"({"inputs": {"a": {"type": "sphere", "radius_mm": 1}, "b": {"type": "sphere", "center_mm": [9, 0, 0], "radius_mm": 1}}, "operations": [{"name": "i", "op": "intersection", "of": ["a", "b"]}], "outputs": [{"of": "i", "file": "x.stl"}]})", "", "", "empty"},
   };
 }
@@ -728,7 +737,9 @@ TEST(Cli, BcifsVolumeMeasureAndErrors) {
       "open": {"type": "bcifs_volume", "cell": "hexahedron", "edge_mm": 10, "edge": "B2", "params": "B2 B2 B2",
                "level": 1, "lacuna_scale": 0.5, "center_mm": [20, 0, 0]}},
       "outputs": [{"of": "plain", "file": "plain.stl"}]})");
-  Result m = lacuna("bcifs measure " + quote((dir / "v.json").string()) + " --levels 0..4 --json", dir.path());
+  Result m = lacuna("bcifs measure " + quote((dir / "v.json").string()) + " --levels 0..4 --json -o " +
+                        quote((dir / "m").string()),
+                    dir.path());
   ASSERT_EQ(m.code, 0) << m.err;
   const nlohmann::json plain = nlohmann::json::parse(m.out)["plain"];
   EXPECT_EQ(plain["topology"][0]["cells"], (nlohmann::json{1, 6, 36, 216, 1296}));
@@ -739,7 +750,25 @@ TEST(Cli, BcifsVolumeMeasureAndErrors) {
   const nlohmann::json open = nlohmann::json::parse(m.out)["open"];
   EXPECT_EQ(open["tunnels"][1], 6);
   EXPECT_EQ(open["genus"][1], 5);
-  EXPECT_FALSE(fs::exists(dir / "v_measures"));  // no pictures for volumes, so no folder
+  // The level-4 cube sampled at the voxel centres of a 256^3 grid over its box (with a margin of sqrt(2)/128 of
+  // the side each end): the centres inside, times a voxel's volume, are the cells' volume but for voxels within
+  // half a diagonal of the surface, whose area is at most S_4.
+  const double side = 10 * (1 + 2 * std::sqrt(2.0) / 128), h = side / 256;
+  EXPECT_NEAR(plain["box_counting"]["fill"].get<double>() * side * side * side, 1000 * std::pow(0.875, 4),
+              plain["surface_mm2"][4].get<double>() * h * std::sqrt(3.0));
+  EXPECT_GT(plain["box_counting"]["region_dimension"].get<double>(), 2.5);
+  EXPECT_LE(plain["box_counting"]["region_dimension"].get<double>(), 3.0);
+  ASSERT_EQ(plain["sections"].size(), 3u);
+  for (const auto& section : plain["sections"]) {
+    EXPECT_NEAR(section["at_mm"].get<double>(), 0, 1e-6);
+    // The middle planes cross the central lacuna (a cube of half the edge): three quarters of the square at most.
+    EXPECT_LT(section["fill"].get<double>(), 0.75);
+    const std::string png = read_file(section["density_map"].get<std::string>());
+    ASSERT_GT(png.size(), 24u);
+    EXPECT_EQ(png.substr(1, 3), "PNG");
+    EXPECT_EQ((uint8_t(png[18]) << 8) | uint8_t(png[19]), 1024);  // IHDR width
+  }
+  EXPECT_TRUE(fs::exists(plain["plot"].get<std::string>()));
 
   Result r = lacuna("run " + quote((dir / "v.json").string()) + " -o " + quote((dir / "out").string()) + " --json",
                     dir.path());
@@ -792,7 +821,10 @@ TEST(Cli, BcifsInfillConformsToTheHull) {
       "plain": {"type": "bcifs_infill", "hull": "box", "skin_mm": 1, "cell_mm": 6, "level": 2, "edge": "B2",
                 "params": "B2 B2 B2", "lacuna_scale": 0.5, "face_lacuna_scale": 0.7, "equal_lacunas": false},
       "sealed": {"type": "bcifs_infill", "hull": "box", "skin_mm": 1, "cell_mm": 6, "level": 1, "walls": "plain",
-                 "interior": "plain", "lacuna_scale": 0.5}},
+                 "interior": "plain", "lacuna_scale": 0.5, "equal_lacunas": false},
+      "graded": {"type": "bcifs_infill", "hull": "box", "skin_mm": 1, "cell_mm": 6, "level": 2, "walls": "plain",
+                 "interior": "plain", "lacuna_scale": 0.5, "equal_lacunas": false,
+                 "grade": {"field": "ramp", "axis": [1, 0, 0], "from_mm": -6.5, "to_mm": 6.5, "levels": 1}}},
       "outputs": [{"of": "equal", "file": "equal.stl"}, {"of": "sealed", "file": "sealed.stl"}]})");
   Result r = lacuna("run " + quote((dir / "fill.json").string()) + " -o " + quote((dir / "out").string()) + " --json",
                     dir.path());
@@ -817,7 +849,19 @@ TEST(Cli, BcifsInfillConformsToTheHull) {
   const double spread_equal = equal["lacuna_mm"][1].get<double>() / equal["lacuna_mm"][0].get<double>();
   const double spread_plain = plain["lacuna_mm"][1].get<double>() / plain["lacuna_mm"][0].get<double>();
   EXPECT_LT(spread_equal, spread_plain);
-  EXPECT_LT(spread_equal, 3.6);  // within one level's shrink (about 3.5)
+  EXPECT_LT(spread_equal, 1.5);  // delays and last lacuna scales
+  EXPECT_GT(spread_plain, 1.5);
+  EXPECT_LT(equal["lacuna_scale"][0].get<double>(), 0.5);
+  EXPECT_EQ(plain["lacuna_scale"], nlohmann::json::parse("[0.5, 0.5]"));
+  // Graded by a ramp across x: cells left of x = 0 keep level 1 (7/8 of their volume), those right of it level 2
+  // (49/64). The grid and the inset are symmetric under p -> -p, which swaps the halves: half the tetrahedra's
+  // volume each, so the graded volume is the level-1 volume times (1 + 7/8) / 2.
+  const nlohmann::json graded = inputs["graded"];
+  EXPECT_EQ(graded["levels"], nlohmann::json::parse("[1, 2]"));
+  EXPECT_EQ(equal["levels"], nlohmann::json::parse("[2, 2]"));
+  EXPECT_EQ(graded["max_delay"], 2);
+  EXPECT_NEAR(graded["volume_mm3"].get<double>(), sealed["volume_mm3"].get<double>() * 15 / 16,
+              1e-9 * sealed["volume_mm3"].get<double>());
   const TriMesh cells = read_mesh((dir / "out" / "equal.stl").string());
   double farthest = 0;
   for (const Vec3d& p : cells.positions_mm)

@@ -159,5 +159,26 @@ TEST(ReportPage, InputFiguresOfPlatesAndPatterns) {
   EXPECT_EQ(count(svg, "<circle "), motifs / 4 * 9);
 }
 
+// A lacunar volume: its three middle sections' density maps (1024 x 1024) and its measure plot (1200 x 400).
+TEST(ReportPage, InputFiguresOfVolumes) {
+  test::TempDir dir;
+  test::write_file(dir / "r.json", R"({"lacuna_recipe": 1, "name": "r", "voxel_size_mm": 0.3,
+    "inputs": {"v": {"type": "bcifs_volume", "cell": "hexahedron", "edge_mm": 8, "edge": "B2", "params": "B2 B2 B2",
+                     "level": 1, "center_mm": [0, 0, 4]}},
+    "outputs": [{"of": "v", "file": "v.stl"}]})");
+  RunOptions options;
+  options.output_dir = (dir / "out").string();
+  const RunReport report = run((dir / "r.json").string(), options);
+  ASSERT_TRUE(report.valid);
+  const std::string html = test::read_file(dir / "out" / "report.html");
+  const nlohmann::json pictures = nlohmann::json::parse(script_text(html, "lacuna-page-data"))["pictures"];
+  ASSERT_EQ(pictures.size(), 4u);
+  EXPECT_EQ(pictures[0]["caption"], "v: density of the section x = 0 mm at level 1 (windows of 31 of 1024 pixels)");
+  EXPECT_EQ(pictures[2]["caption"], "v: density of the section z = 4 mm at level 1 (windows of 31 of 1024 pixels)");
+  for (size_t i = 0; i < 3; ++i)
+    EXPECT_EQ(png_size(unbase64(pictures[i]["data"].get<std::string>())), (std::pair<uint32_t, uint32_t>{1024, 1024}));
+  EXPECT_EQ(png_size(unbase64(pictures[3]["data"].get<std::string>())), (std::pair<uint32_t, uint32_t>{1200, 400}));
+}
+
 }  // namespace
 }  // namespace lacuna

@@ -725,7 +725,8 @@ void write_png(const std::string& path, int width, int height, const std::vector
 }
 
 std::vector<uint8_t> plot_measures(const GeometricMeasures& measures, const BoxCount& boxes,
-                                   const std::vector<double>& ratio, double ratio_limit, int width, int height) {
+                                   const std::vector<double>& ratio, double ratio_limit, int width, int height,
+                                   const PlotLabels& labels) {
   if (width < 300 || height < 150) throw InvalidInput("plot_measures: the image must be at least 300 x 150");
   Canvas canvas{width, height, std::vector<uint8_t>(3 * size_t(width) * size_t(height), 255)};
   const std::array<uint8_t, 3> black{0, 0, 0}, red{220, 0, 0}, blue{0, 0, 220}, green{0, 160, 0}, purple{140, 0, 170},
@@ -789,12 +790,15 @@ std::vector<uint8_t> plot_measures(const GeometricMeasures& measures, const BoxC
   for (double v : la) lo = std::min(lo, v), hi = std::max(hi, v);
   for (double v : lp) lo = std::min(lo, v), hi = std::max(hi, v);
   const double first = measures.first_level;
-  const Frame left = make_frame(first, first + std::max(1.0, double(la.size()) - 1), lo, hi, 0, "AREA, PERIMETER", "LEVEL I",
-                                "LN(A_I/A_0), LN(P_I/P_0)");
+  const std::string& a = labels.first_symbol;
+  const std::string& p = labels.second_symbol;
+  const Frame left = make_frame(first, first + std::max(1.0, double(la.size()) - 1), lo, hi, 0,
+                                labels.first + ", " + labels.second, "LEVEL I",
+                                "LN(" + a + "_I/" + a + "_0), LN(" + p + "_I/" + p + "_0)");
   series(left, la, first, red);
   series(left, lp, first, blue);
-  legend(left, 0, "AREA", red, false);
-  legend(left, 1, "PERIMETER", blue, false);
+  legend(left, 0, labels.first, red, false);
+  legend(left, 1, labels.second, blue, false);
   // Middle: ln N against ln(1/eps), and the fitted line through the mean point.
   if (!boxes.log_count.empty()) {
     const auto [xmin, xmax] = std::minmax_element(boxes.log_inverse_size.begin(), boxes.log_inverse_size.end());

@@ -188,8 +188,14 @@ void write_png(const std::string& path, int width, int height, const std::vector
 // with their ranges and a legend: left ln(A_i/A_first) (red) and ln(P_i/P_first) (blue) against the
 // level; middle the box-counting points (black) and their fitted line (green, D); right R_i (purple)
 // against the level, to level ratio.size() - 1, and its limit R (grey, dashed).
+// `labels` names the two measures (a volume's plot shows volume V and surface S in their place).
+struct PlotLabels {
+  std::string first = "AREA", second = "PERIMETER";  // upper case: the plot's font has no lower case
+  std::string first_symbol = "A", second_symbol = "P";
+};
 std::vector<uint8_t> plot_measures(const GeometricMeasures& measures, const BoxCount& boxes,
-                                   const std::vector<double>& ratio, double ratio_limit, int width, int height);
+                                   const std::vector<double>& ratio, double ratio_limit, int width, int height,
+                                   const PlotLabels& labels = {});
 
 }  // namespace bcifs
 }  // namespace lacuna

@@ -430,6 +430,8 @@ double volume_lacunas(const VolumeRules& rules, int level) {
 void validate(const VolumeGeometryOptions& options) {
   if (!(options.lacuna_scale > 0 && options.lacuna_scale < 1))
     throw InvalidInput("the cells' lacuna_scale must be in (0, 1), got " + std::to_string(options.lacuna_scale));
+  for (double s : options.last_lacuna_scale)
+    if (!(s > 0 && s < 1)) throw InvalidInput("a cell's last lacuna scale must be in (0, 1), got " + std::to_string(s));
   validate(options.faces);
 }
 
@@ -440,6 +442,9 @@ class Realizer {
  public:
   Realizer(const VolumeRules& rules, const VolumeSpec& spec, const VolumeGeometryOptions& options)
       : rules_(rules), spec_(spec), options_(options) {
+    if (!options.last_lacuna_scale.empty() && options.last_lacuna_scale.size() != spec.cells.size())
+      throw InvalidInput("lacunar volume: " + std::to_string(options.last_lacuna_scale.size()) +
+                         " last lacuna scales for " + std::to_string(spec.cells.size()) + " cells");
     for (size_t t = 0; t < rules.cells.size(); ++t) ids_[rules.cells[t].cell] = int(t);
   }
 
@@ -472,12 +477,14 @@ class Realizer {
     return out;
   }
 
-  VolumeLevel next(const VolumeLevel& level) {
+  // `last`: the realization's last subdivision, where the cells' last lacuna scales apply.
+  VolumeLevel next(const VolumeLevel& level, bool last) {
     VolumeLevel out;
     out.level = level.level + 1;
     keys_.clear();
-    const double s = options_.lacuna_scale;
+    const bool own_scales = last && !options_.last_lacuna_scale.empty();
     for (const VolumeCell& cell : level.cells) {
+      const double s = own_scales ? options_.last_lacuna_scale[size_t(cell.origin)] : options_.lacuna_scale;
       if (cell.delay >= 2) {
         VolumeCell child = cell;
         child.delay = cell.delay - 1;
@@ -613,7 +620,7 @@ VolumeLevel realize_volume(const VolumeRules& rules, const VolumeSpec& spec, int
   check_cell_count(rules, levels);
   Realizer realizer(rules, spec, options);
   VolumeLevel level = realizer.first();
-  for (int i = 0; i < levels; ++i) level = realizer.next(level);
+  for (int i = 0; i < levels; ++i) level = realizer.next(level, i + 1 == levels);
   return level;
 }
 
@@ -754,8 +761,10 @@ double level_shrink(const VolumeSpec& spec, int cell, const VolumeGeometryOption
   alone.cells.push_back(spec.cells[size_t(cell)]);
   alone.cells[0].delay = 1;
   const VolumeRules rules = build_volume_rules(alone);
+  VolumeGeometryOptions common = options;
+  common.last_lacuna_scale.clear();
   auto mean_size = [&](int level) {
-    const VolumeLevel l = realize_volume(rules, alone, level, options);
+    const VolumeLevel l = realize_volume(rules, alone, level, common);
     double sum = 0;
     for (const VolumeCell& c : l.cells) sum += std::log(std::cbrt(cell_volume(l, c, alone)));
     return std::exp(sum / double(l.cells.size()));
@@ -783,16 +792,37 @@ std::vector<int> delays_for_sizes(const std::vector<double>& sizes_mm, int level
 std::vector<double> last_lacuna_sizes(const VolumeRules& rules, const VolumeSpec& spec, int level,
                                       const VolumeGeometryOptions& options) {
   if (level < 1) throw InvalidInput("last_lacuna_sizes: level must be >= 1");
-  const VolumeLevel before = realize_volume(rules, spec, level - 1, options);
+  if (!options.last_lacuna_scale.empty() && options.last_lacuna_scale.size() != spec.cells.size())
+    throw InvalidInput("last_lacuna_sizes: one last lacuna scale per cell expected");
+  VolumeGeometryOptions before_options = options;  // the last scales belong to the subdivision after `before`
+  before_options.last_lacuna_scale.clear();
+  const VolumeLevel before = realize_volume(rules, spec, level - 1, before_options);
   std::vector<double> log_sum(spec.cells.size(), 0.0), count(spec.cells.size(), 0.0);
   for (const VolumeCell& cell : before.cells) {
     if (cell.delay != 1) continue;
-    log_sum[size_t(cell.origin)] += std::log(options.lacuna_scale * std::cbrt(cell_volume(before, cell, spec)));
+    const double s =
+        options.last_lacuna_scale.empty() ? options.lacuna_scale : options.last_lacuna_scale[size_t(cell.origin)];
+    log_sum[size_t(cell.origin)] += std::log(s * std::cbrt(cell_volume(before, cell, spec)));
     count[size_t(cell.origin)] += 1;
   }
   std::vector<double> out;
   for (size_t c = 0; c < spec.cells.size(); ++c) out.push_back(count[c] > 0 ? std::exp(log_sum[c] / count[c]) : 0.0);
   return out;
+}
+
+std::vector<double> lacuna_scales_for_sizes(const std::vector<double>& sizes_mm, double lacuna_scale) {
+  if (!(lacuna_scale > 0 && lacuna_scale < 1)) throw InvalidInput("lacuna_scales_for_sizes: the scale must be in (0, 1)");
+  std::vector<double> made;
+  for (double l : sizes_mm) {
+    if (!(l >= 0 && std::isfinite(l))) throw InvalidInput("lacuna_scales_for_sizes: sizes must be >= 0");
+    if (l > 0) made.push_back(l);
+  }
+  std::vector<double> scales(sizes_mm.size(), lacuna_scale);
+  if (made.empty()) return scales;
+  const double target = *std::min_element(made.begin(), made.end());
+  for (size_t c = 0; c < sizes_mm.size(); ++c)
+    if (sizes_mm[c] > 0) scales[c] = std::max(lacuna_scale * target / sizes_mm[c], lacuna_scale / 3);
+  return scales;
 }
 
 VolumeMeasures volume_measures(const VolumeRules& rules, const VolumeSpec& spec, int levels,
@@ -822,7 +852,7 @@ VolumeMeasures volume_measures(const VolumeRules& rules, const VolumeSpec& spec,
       if (face.type >= 0 && rules.faces.rules[size_t(face.type)].face.delay == 1) opened += 1;
     for (const VolumeCell& cell : level.cells) lacunas += cell.delay == 1;
     tunnels += opened;
-    level = realizer.next(level);
+    level = realizer.next(level, i + 1 == levels);
   }
   if (levels > 0) {
     m.volume_factor = std::pow(m.volume.back() / m.volume.front(), 1.0 / levels);

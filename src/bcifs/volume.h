@@ -139,6 +139,10 @@ double volume_lacunas(const VolumeRules& rules, int level);
 struct VolumeGeometryOptions {
   double lacuna_scale = 0.5;  // the cell's lacuna: the cell scaled about its apex, in (0, 1)
   GeometryOptions faces;      // the faces' rules (gap_fraction, their own lacuna_scale, notch_depth)
+  // Per cell of the spec, or empty: the lacuna scale of its descendants' last subdivision (the one that makes the
+  // level realized); lacuna_scale before it. A cell's own lacuna touches no face it shares with another cell (its
+  // faces subdivide by their face rules alone), so cells may differ here and the assembly stays consistent.
+  std::vector<double> last_lacuna_scale;
 };
 
 // Throws InvalidInput unless every option is in (0, 1).
@@ -201,10 +205,46 @@ double level_shrink(const VolumeSpec& spec, int cell, const VolumeGeometryOption
 std::vector<int> delays_for_sizes(const std::vector<double>& sizes_mm, int level, double shrink);
 
 // The size of the lacunas the last subdivision makes (level - 1 to level), per cell of the spec: the geometric
-// mean of lacuna_scale * cbrt(volume) over that cell's descendants that subdivide then; 0 for a cell whose
-// descendants are all still delayed.
+// mean of s * cbrt(volume) over that cell's descendants that subdivide then (s its last lacuna scale); 0 for a
+// cell whose descendants are all still delayed.
 std::vector<double> last_lacuna_sizes(const VolumeRules& rules, const VolumeSpec& spec, int level,
                                       const VolumeGeometryOptions& options = {});
+
+// Last lacuna scales that bring the cells' last lacunas to one size, from their sizes at `lacuna_scale`
+// (last_lacuna_sizes without last scales): the target is the smallest size, a cell of size L gets
+// lacuna_scale * target / L, at least lacuna_scale / 3; a cell of size 0 (no lacuna) keeps lacuna_scale. Lacunas
+// only shrink, so no wall is thinner than lacuna_scale makes it (larger scales for the small cells thinned
+// their walls into loose crumbs). Delays by size leave the sizes within about one shrink (3 to 4 for B2 walls) of
+// each other; up to 3 apart they end equal.
+std::vector<double> lacuna_scales_for_sizes(const std::vector<double>& sizes_mm, double lacuna_scale);
+
+// Sampling a level's convex pieces (convex_pieces) for box counting and sections.
+// A cube of size^3 voxels over the pieces' bounding box: its side the box's longest plus a margin of sqrt(2)/128 of
+// it on each end, from the box's lowest corner less the margin (so that faces at fixed ratios of the box do not all
+// sit at one offset from the voxel centres).
+struct VoxelGrid {
+  int size = 0;
+  Vec3d origin_mm;
+  double voxel_mm = 0;
+};
+
+// Throws InvalidInput unless size is a power of two from 4 to 1024 and there is a piece.
+VoxelGrid voxel_grid(const std::vector<ConvexCells>& pieces, int size);
+
+// The voxels of layers z_first <= z < z_last whose centre lies in a piece (on a face counts): 1, else 0, written
+// to out (size^2 per layer, x fastest, then y). Layers are independent: callers may mark them in parallel.
+void mark_voxels(const std::vector<ConvexCells>& pieces, const VoxelGrid& grid, int z_first, int z_last, uint8_t* out);
+
+// Box counts of a size^3 mask (x fastest, then y, then z) on its cube: eps = 1/4 .. 1/size of the side, N_eps the
+// boxes holding a voxel of the set, or with `boundary` a voxel of the set that has a 6-neighbour outside it or lies
+// on the cube's border. Throws InvalidInput unless size is a power of two >= 4 and mask.size() = size^3.
+BoxCount box_count_3d(const std::vector<uint8_t>& mask, int size, bool boundary);
+
+// The section of the pieces by the plane where coordinate `axis` (0 x, 1 y, 2 z) equals `value`: pixel centres
+// of a size x size square over the grid's cube in the other two coordinates (u = axis + 1, v = axis + 2, mod 3),
+// 1 inside a piece; row-major, rows along v from the cube's low end.
+std::vector<uint8_t> section_mask(const std::vector<ConvexCells>& pieces, const VoxelGrid& grid, int axis,
+                                  double value, int size);
 
 struct VolumeMeasures {
   std::vector<double> volume;   // V_i, i = 0..levels: the cells' volumes summed

@@ -120,7 +120,33 @@ int bcifs_measure(const BcifsArgs& a) {
                       {"F_V", g.volume_factor},
                       {"F_S", g.surface_factor},
                       {"tunnels", g.tunnels},
-                      {"genus", g.genus}};
+                      {"genus", g.genus},
+                      {"box_counting",
+                       {{"grid", kVolumeBoxGrid},
+                        {"fill", m.grid_fill},
+                        {"region_dimension", m.region.dimension},
+                        {"boundary_dimension", m.boundary.dimension},
+                        {"log_inverse_size", m.region.log_inverse_size},
+                        {"region_log_count", m.region.log_count},
+                        {"boundary_log_count", m.boundary.log_count}}}};
+      VolumeImages drawn = volume_images(m, a.mask_px);
+      nlohmann::json sections = nlohmann::json::array();
+      for (size_t axis = 0; axis < 3; ++axis) {
+        const std::string file = (out_dir / (name + "_section_" + "xyz"[axis] + ".png")).string();
+        double fill = 0;
+        for (uint8_t v : m.sections[axis]) fill += v;
+        fill /= double(m.sections[axis].size());
+        sections.push_back({{"axis", std::string(1, "xyz"[axis])},
+                            {"at_mm", m.section_mm[axis]},
+                            {"fill", fill},
+                            {"density_map", file}});
+        images.push_back({file, std::move(drawn.section_png[axis])});
+      }
+      const std::string plot_file = (out_dir / (name + "_plot.png")).string();
+      images.push_back({plot_file, std::move(drawn.plot_png)});
+      result[name]["sections"] = sections;
+      result[name]["mask_px"] = a.mask_px;
+      result[name]["plot"] = plot_file;
       continue;
     }
     if (!value.is_object() || value.value("type", "") != "bcifs_plate") continue;
@@ -193,6 +219,14 @@ int bcifs_measure(const BcifsArgs& a) {
         std::printf("  cell type %d: N^C %g, N^L %g, R_%d %.6g, R %.9g\n", c["type"].get<int>(),
                     c["cells"].back().get<double>(), c["lacunas"].back().get<double>(), hi,
                     c["ratio"].back().get<double>(), c["r_limit"].get<double>());
+      const nlohmann::json& boxes = e["box_counting"];
+      std::printf("  level %d on a %d^3 grid: fill %.4g, box-counting dimension %.4g (solid), %.4g (boundary)\n",
+                  e["geometry_levels"][1].get<int>(), boxes["grid"].get<int>(), boxes["fill"].get<double>(),
+                  boxes["region_dimension"].get<double>(), boxes["boundary_dimension"].get<double>());
+      for (const auto& c : e["sections"])
+        std::printf("  section %s = %.6g mm: fill %.4g, wrote %s\n", c["axis"].get<std::string>().c_str(),
+                    c["at_mm"].get<double>(), c["fill"].get<double>(), c["density_map"].get<std::string>().c_str());
+      std::printf("  wrote %s\n", e["plot"].get<std::string>().c_str());
       continue;
     }
     for (size_t i = 0; i < e["area_mm2"].size(); ++i)

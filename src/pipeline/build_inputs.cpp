@@ -581,6 +581,7 @@ class Builder {
     report.r_limit = bcifs::volume_lacunarity(rules, rules.roots[0], v.level).limit;
     add_cells(rules, v.spec, v.level, v.options, report);
     out_.report = report;
+    out_.volume = std::make_shared<const BcifsVolumeInput>(v);
   }
 
   // The rules of a volume's cells; their errors name this input.
@@ -714,33 +715,72 @@ class Builder {
       spec.cells.push_back(std::move(c));
     }
     if (spec.cells.empty()) fail("cell_mm", "the inset hull holds no cell");
+    // The levels a grade takes away per tetrahedron, read at its corners' average (as a lattice's level grade).
+    std::vector<int> lowered(spec.cells.size(), 0);
+    if (b.grade.kind != GradeField::Kind::kNone) {
+      const Field depth = b.grade.kind == GradeField::Kind::kDepth ? depth_in(b.hull, b.grade.depth_mm) : Field{};
+      for (size_t c = 0; c < spec.cells.size(); ++c) {
+        Vec3d centre{0, 0, 0};
+        for (const Vec3d& p : spec.cells[c].shape.corners_mm) centre += p * 0.25;
+        const double g = b.grade.at(centre, depth);
+        int raised = 0;
+        for (int k = 0; k < b.grade_levels; ++k) raised += g > double(k + 1) / double(b.grade_levels + 1);
+        lowered[c] = b.grade_levels - raised;
+      }
+    }
+    std::vector<int> delays(spec.cells.size(), 1);
     if (b.equal_lacunas) {
       // What a level does to a full cell inside the hull (the largest: one the surface did not move).
       const size_t reference = size_t(std::max_element(sizes.begin(), sizes.end()) - sizes.begin());
       const double shrink = bcifs::level_shrink(spec, int(reference), b.options);
-      const std::vector<int> delays = bcifs::delays_for_sizes(sizes, b.level, shrink);
-      for (size_t c = 0; c < spec.cells.size(); ++c) spec.cells[c].delay = delays[c];
+      delays = bcifs::delays_for_sizes(sizes, b.level, shrink);
     }
+    // A lower level is a longer delay: the faces between cells of different levels stay consistent.
+    for (size_t c = 0; c < spec.cells.size(); ++c) spec.cells[c].delay = std::min(delays[c] + lowered[c], b.level);
     const bcifs::VolumeRules rules = volume_rules(spec);
     const double cells = bcifs::volume_cells(rules, b.level);
     if (cells > bcifs::kMaxVolumeCells)
       throw ResourceLimit(where() + ": " + std::to_string(spec.cells.size()) + " tetrahedra at level " +
                           std::to_string(b.level) + " make " + message_number(cells) + " cells, more than " +
                           message_number(bcifs::kMaxVolumeCells) + "; use larger cell_mm or a lower level");
+    // The lacunas the last level makes, per tetrahedron (those still all delayed make none); with equal_lacunas
+    // each tetrahedron's last lacuna scale brings them down to the smallest of the tetrahedra graded alike.
+    bcifs::VolumeGeometryOptions options = b.options;
+    std::vector<double> lacuna_sizes = bcifs::last_lacuna_sizes(rules, spec, b.level, options);
+    if (b.equal_lacunas) {
+      options.last_lacuna_scale.assign(spec.cells.size(), options.lacuna_scale);
+      for (int lower = 0; lower <= b.grade_levels; ++lower) {
+        std::vector<double> group;
+        for (size_t c = 0; c < spec.cells.size(); ++c)
+          if (lowered[c] == lower) group.push_back(lacuna_sizes[c]);
+        const std::vector<double> scales = bcifs::lacuna_scales_for_sizes(group, options.lacuna_scale);
+        for (size_t c = 0, k = 0; c < spec.cells.size(); ++c)
+          if (lowered[c] == lower) options.last_lacuna_scale[c] = scales[k++];
+      }
+      // A lacuna is its cell scaled: the sizes scale with the last lacuna scales.
+      for (size_t c = 0; c < spec.cells.size(); ++c)
+        lacuna_sizes[c] *= options.last_lacuna_scale[c] / options.lacuna_scale;
+    }
     BcifsVolumeReport report;
-    add_cells(rules, spec, b.level, b.options, report);
+    add_cells(rules, spec, b.level, options, report);
     report.tetrahedra = spec.cells.size();
     report.min_cell_mm = *std::min_element(sizes.begin(), sizes.end());
     report.max_cell_mm = *std::max_element(sizes.begin(), sizes.end());
     for (const bcifs::CellSpec& c : spec.cells) report.max_delay = std::max(report.max_delay, c.delay);
-    // The lacunas the last level makes, per tetrahedron (those still all delayed make none).
     report.min_lacuna_mm = HUGE_VAL;
-    for (double l : bcifs::last_lacuna_sizes(rules, spec, b.level, b.options))
+    for (double l : lacuna_sizes)
       if (l > 0) {
         report.min_lacuna_mm = std::min(report.min_lacuna_mm, l);
         report.max_lacuna_mm = std::max(report.max_lacuna_mm, l);
       }
     if (!(report.max_lacuna_mm > 0)) report.min_lacuna_mm = 0;
+    report.min_lacuna_scale = report.max_lacuna_scale = options.lacuna_scale;
+    for (double s : options.last_lacuna_scale) {
+      report.min_lacuna_scale = std::min(report.min_lacuna_scale, s);
+      report.max_lacuna_scale = std::max(report.max_lacuna_scale, s);
+    }
+    report.min_level = b.level - *std::max_element(lowered.begin(), lowered.end());
+    report.max_level = b.level - *std::min_element(lowered.begin(), lowered.end());
     out_.report = report;
   }
 

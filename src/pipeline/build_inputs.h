@@ -24,8 +24,9 @@ struct BuiltInput {
   GeometrySet geometry;
   InputReport report;
   // What the report page draws of it (pipeline/input_figures.h): a lacunar plate's rule set and
-  // realization, a wallpaper pattern's fundamental region.
+  // realization, a lacunar volume's sections and measures, a wallpaper pattern's fundamental region.
   std::shared_ptr<const bcifs::Plate> plate;
+  std::shared_ptr<const BcifsVolumeInput> volume;
   std::shared_ptr<const fill::WallpaperFill> pattern;
 };
 

@@ -1,7 +1,9 @@
 #include "pipeline/generators.h"
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <nlohmann/json.hpp>
@@ -271,6 +273,27 @@ VolumeCellMeasures measure_volume(const bcifs::VolumeSpec& spec, const bcifs::Vo
   while (m.geometry_last < last && bcifs::volume_cells(rules, m.geometry_last + 1) <= kMaxMeasuredCells)
     ++m.geometry_last;
   m.geometry = bcifs::volume_measures(rules, spec, m.geometry_last, options);
+  const std::vector<ConvexCells> pieces =
+      bcifs::convex_pieces(bcifs::realize_volume(rules, spec, m.geometry_last, options), spec);
+  const bcifs::VoxelGrid grid = bcifs::voxel_grid(pieces, kVolumeBoxGrid);
+  const size_t n = size_t(grid.size);
+  std::vector<uint8_t> mask(n * n * n);
+  tbb::parallel_for(tbb::blocked_range<int>(0, grid.size, 8), [&](const tbb::blocked_range<int>& r) {
+    bcifs::mark_voxels(pieces, grid, r.begin(), r.end(), mask.data() + size_t(r.begin()) * n * n);
+  });
+  size_t set = 0;
+  for (uint8_t v : mask) set += v;
+  m.grid_fill = double(set) / double(mask.size());
+  m.region = bcifs::box_count_3d(mask, grid.size, false);
+  m.boundary = bcifs::box_count_3d(mask, grid.size, true);
+  Vec3d lo{HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  for (const ConvexCells& cells : pieces)
+    for (const Vec3d& p : cells.corners_mm)
+      for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
+  tbb::parallel_for(0, 3, [&](int axis) {
+    m.section_mm[size_t(axis)] = 0.5 * (lo[axis] + hi[axis]);
+    m.sections[size_t(axis)] = bcifs::section_mask(pieces, grid, axis, m.section_mm[size_t(axis)], kSectionPixels);
+  });
   return m;
 }
 

@@ -4,6 +4,7 @@
 // names its own option in messages.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <nlohmann/json_fwd.hpp>
 #include <optional>
@@ -136,7 +137,17 @@ struct VolumeCellMeasures {
   size_t cell_type_count = 0, face_type_count = 0;
   bcifs::VolumeMeasures geometry;        // volumes, surfaces, tunnels, genus of levels 0 .. geometry_last
   int geometry_last = 0;                 // min(last, the deepest level with at most kMaxMeasuredCells cells)
+  // Level geometry_last's solid sampled at the centres of a kVolumeBoxGrid^3 grid over its bounding cube: box
+  // counts in 3D of the solid (region) and of its boundary voxels, and its sections by the three planes through
+  // the middle of its box (x, y, z), kSectionPixels^2 masks over the cube's square (bcifs::section_mask).
+  bcifs::BoxCount region, boundary;
+  std::array<std::vector<uint8_t>, 3> sections;
+  std::array<double, 3> section_mm{};    // where each section's plane lies
+  double grid_fill = 0;                  // the set voxels' share of the grid
 };
+
+constexpr int kVolumeBoxGrid = 256;
+constexpr int kSectionPixels = 1024;
 
 // The most cells `bcifs measure` realizes for a volume's geometry (a few hundred MB).
 constexpr double kMaxMeasuredCells = 300000;

@@ -1,6 +1,7 @@
 #include "pipeline/input_figures.h"
 
 #include <algorithm>
+#include <cstdio>
 
 #include "bcifs/realize.h"
 #include "bcifs/topology.h"
@@ -38,6 +39,29 @@ PlateImages plate_images(const PlateMeasures& measures, int mask_px) {
   return images;
 }
 
+VolumeImages volume_images(const VolumeCellMeasures& measures, int mask_px) {
+  VolumeImages images;
+  for (size_t axis = 0; axis < 3; ++axis) {
+    const std::vector<uint8_t> density =
+        bcifs::density_colours(bcifs::density_map(measures.sections[axis], kSectionPixels, kSectionPixels, mask_px));
+    images.section_png[axis] =
+        bcifs::encode_png(kSectionPixels, kSectionPixels, flip_rows(density, kSectionPixels, kSectionPixels), 6);
+  }
+  bcifs::GeometricMeasures g;
+  g.area = measures.geometry.volume;
+  g.perimeter = measures.geometry.surface;
+  const std::vector<double> ratio = measures.cells.empty() ? std::vector<double>{} : measures.cells[0].ratio;
+  const double limit = measures.cells.empty() ? 0 : measures.cells[0].limit;
+  bcifs::PlotLabels labels;
+  labels.first = "VOLUME";
+  labels.second = "SURFACE";
+  labels.first_symbol = "V";
+  labels.second_symbol = "S";
+  images.plot_png =
+      bcifs::encode_png(1200, 400, bcifs::plot_measures(g, measures.region, ratio, limit, 1200, 400, labels), 6);
+  return images;
+}
+
 std::vector<InputFigure> input_figures(const BuiltInputs& inputs) {
   std::vector<InputFigure> figures;
   for (size_t i = 0; i < inputs.names.size(); ++i) {
@@ -54,6 +78,21 @@ std::vector<InputFigure> input_figures(const BuiltInputs& inputs) {
       figures.push_back({name + ": density at level " + std::to_string(level) + " (windows of 31 of 1024 pixels)",
                          "image/png", as_string(images.density_png)});
       figures.push_back({name + ": area and perimeter, box counting (" + levels + ")", "image/png",
+                         as_string(images.plot_png)});
+    }
+    if (input.volume) {
+      // Measured to its level while that has at most kMaxMeasuredCells cells (else to the deepest that has).
+      const VolumeCellMeasures measures = measure_volume(input.volume->spec, input.volume->options, input.volume->level);
+      VolumeImages images = volume_images(measures);
+      const std::string level = std::to_string(measures.geometry_last);
+      for (size_t axis = 0; axis < 3; ++axis) {
+        char at[32];
+        std::snprintf(at, sizeof at, "%.4g", measures.section_mm[axis]);
+        figures.push_back({name + ": density of the section " + "xyz"[axis] + " = " + at + " mm at level " + level +
+                               " (windows of 31 of 1024 pixels)",
+                           "image/png", as_string(images.section_png[axis])});
+      }
+      figures.push_back({name + ": volume and surface, 3D box counting (levels 0 to " + level + "), R_i", "image/png",
                          as_string(images.plot_png)});
     }
     if (input.pattern)

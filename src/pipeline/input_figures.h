@@ -2,6 +2,8 @@
 // `lacuna bcifs measure` draws them), a wallpaper pattern's picture.
 #pragma once
 
+#include <array>
+
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -18,6 +20,14 @@ struct PlateImages {
 
 // The density map and measure plot of a plate's measures.
 PlateImages plate_images(const PlateMeasures& measures, int mask_px = 31);
+
+struct VolumeImages {
+  std::array<std::vector<uint8_t>, 3> section_png;  // 1024 x 1024: the sections' local density (x, y, z planes)
+  std::vector<uint8_t> plot_png;  // 1200 x 400: ln V_i, ln S_i against i, the 3D box counting, R_i of the first cell
+};
+
+// The section density maps (windows of mask_px pixels) and measure plot of a volume's measures.
+VolumeImages volume_images(const VolumeCellMeasures& measures, int mask_px = 31);
 
 struct InputFigure {
   std::string caption;

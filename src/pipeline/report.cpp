@@ -101,6 +101,8 @@ nlohmann::json to_json(const InputReport& report) {
               j["cell_mm"] = {r.min_cell_mm, r.max_cell_mm};
               j["max_delay"] = r.max_delay;
               j["lacuna_mm"] = {r.min_lacuna_mm, r.max_lacuna_mm};
+              j["lacuna_scale"] = {r.min_lacuna_scale, r.max_lacuna_scale};
+              j["levels"] = {r.min_level, r.max_level};
             }
             return j;
           },

@@ -488,6 +488,67 @@ void add_generators(py::module_& m) {
       "faces + shared, radius_mm, gap_fraction, ...), between levels (first, last): per face its N^C_i (subfaces), "
       "N^L_i (lacunas), R_i (ratio) and limit R; areas A_i (mm^2) and perimeters P_i (mm), F_A, F_P, box-counting "
       "dimensions, and the sub-face polygons of the last level (mm).");
+  m.def(
+      "bcifs_volume_measure",
+      [](int last, const py::kwargs& keys) {
+        nlohmann::json object = to_json(keys, "lacuna.bcifs_volume_measure");
+        object["type"] = "bcifs_volume";
+        const Recipe recipe = parse_recipe(
+            nlohmann::json{{"inputs", {{"volume", object}}}, {"outputs", {{{"of", "volume"}, {"file", "volume.stl"}}}}}
+                .dump(),
+            "lacuna.bcifs_volume_measure");
+        const BcifsVolumeInput input = std::get<BcifsVolumeInput>(recipe.inputs.front().spec);
+        const VolumeCellMeasures vm = released([&] { return measure_volume(input.spec, input.options, last); });
+        py::list cells;
+        for (size_t c = 0; c < vm.cells.size(); ++c) {
+          const bcifs::Lacunarity& l = vm.cells[c];
+          py::dict e;
+          e["type"] = vm.cell_types[c];
+          e["cells"] = numbers_array(l.subfaces);
+          e["lacunas"] = numbers_array(l.lacunas);
+          e["ratio"] = numbers_array(l.ratio);
+          e["r_limit"] = l.limit;
+          cells.append(e);
+        }
+        py::dict boxes;
+        boxes["grid"] = kVolumeBoxGrid;
+        boxes["fill"] = vm.grid_fill;
+        boxes["region_dimension"] = vm.region.dimension;
+        boxes["boundary_dimension"] = vm.boundary.dimension;
+        boxes["log_inverse_size"] = numbers_array(vm.region.log_inverse_size);
+        boxes["region_log_count"] = numbers_array(vm.region.log_count);
+        boxes["boundary_log_count"] = numbers_array(vm.boundary.log_count);
+        py::list sections;
+        for (size_t axis = 0; axis < 3; ++axis) {
+          py::array_t<uint8_t> mask({py::ssize_t(kSectionPixels), py::ssize_t(kSectionPixels)});
+          std::copy(vm.sections[axis].begin(), vm.sections[axis].end(), mask.mutable_data());
+          py::dict e;
+          e["axis"] = std::string(1, "xyz"[axis]);
+          e["at_mm"] = vm.section_mm[axis];
+          e["mask"] = mask;
+          sections.append(e);
+        }
+        const bcifs::VolumeMeasures& g = vm.geometry;
+        py::dict d;
+        d["topology"] = cells;
+        d["geometry_levels"] = py::make_tuple(0, vm.geometry_last);
+        d["volume_mm3"] = numbers_array(g.volume);
+        d["surface_mm2"] = numbers_array(g.surface);
+        d["F_V"] = g.volume_factor;
+        d["F_S"] = g.surface_factor;
+        d["tunnels"] = numbers_array(g.tunnels);
+        d["genus"] = numbers_array(g.genus);
+        d["box_counting"] = boxes;
+        d["sections"] = sections;
+        return d;
+      },
+      py::arg("last") = 3,
+      "The measures `lacuna bcifs measure` prints for a lacunar volume given by the keys of a bcifs_volume input "
+      "(cell, edge_mm or cells, walls, edge, params, interior, lacuna_scale, ...), levels 0 to `last`: per cell of "
+      "the assembly N^C_i (cells), N^L_i (lacunas), R_i (ratio) and R; volumes V_i, surfaces S_i, F_V, F_S, tunnels "
+      "and genus to the deepest level of at most 300 000 cells (geometry_levels); at that level the 3D box counting "
+      "on a 256^3 grid (fill: the share of voxel centres inside) and the sections through the middle of its box "
+      "(x, y, z: 1024 x 1024 masks, rows along the second of the other two axes).");
 }
 
 }  // namespace python

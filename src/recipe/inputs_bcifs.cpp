@@ -315,6 +315,17 @@ BcifsInfillInput parse_bcifs_infill_input(const JsonObject& o) {
   if (!(in.skin_mm >= 0 && std::isfinite(in.skin_mm))) o.fail("skin_mm", "expected a skin of 0 mm or more");
   in.cell_mm = o.positive_length_or("cell_mm", 10.0);
   in.equal_lacunas = o.boolean_or("equal_lacunas", true);
+  if (o.has("grade")) {
+    const JsonObject g = o.object("grade");
+    g.allow_only({"levels", "field", "axis", "from_mm", "to_mm", "points_mm", "falloff_mm", "depth_mm"});
+    in.grade = parse_grade_field(g, "");
+    if (in.level < 2) o.fail("grade", "a grade lowers the level somewhere: it needs level 2 or more");
+    const uint64_t levels = g.unsigned_integer_or("levels", uint64_t(in.level - 1));
+    if (levels < 1 || levels >= uint64_t(in.level))
+      g.fail("levels", "expected 1 to level - 1 = " + std::to_string(in.level - 1) +
+                           " levels the field may take away (every cell subdivides at least once)");
+    in.grade_levels = int(levels);
+  }
   return in;
 }
 

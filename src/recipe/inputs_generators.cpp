@@ -63,6 +63,30 @@ BSplinePatch parse_patch(const JsonObject& p) {
 
 }  // namespace
 
+GradeField parse_grade_field(const JsonObject& g, const std::string& no_depth) {
+  GradeField f;
+  std::string field = g.string("field");
+  if (field == "ramp") {
+    f.kind = GradeField::Kind::kRamp;
+    f.axis = g.direction_or("axis", Vec3d{0, 0, 1});
+    f.from_mm = g.number("from_mm");
+    f.to_mm = g.number("to_mm");
+    if (f.from_mm == f.to_mm) g.fail("to_mm", "expected a value different from from_mm");
+  } else if (field == "points") {
+    f.kind = GradeField::Kind::kPoints;
+    f.points_mm = g.vec3_list("points_mm");
+    if (f.points_mm.empty()) g.fail("points_mm", "expected at least one point");
+    f.falloff_mm = g.positive_length("falloff_mm");
+  } else if (field == "depth") {
+    f.kind = GradeField::Kind::kDepth;
+    f.depth_mm = g.positive_length("depth_mm");
+    if (!no_depth.empty()) g.fail("field", no_depth);
+  } else {
+    g.fail("field", "expected \"ramp\", \"points\" or \"depth\", got \"" + field + "\"");
+  }
+  return f;
+}
+
 LatticeInput parse_lattice_input(const JsonObject& o) {
   LatticeInput in;
   LatticeOptions& options = in.lattice;
@@ -104,26 +128,7 @@ LatticeInput parse_lattice_input(const JsonObject& o) {
     } else {
       g.fail("parameter", "expected \"radius\" or \"level\", got \"" + parameter + "\"");
     }
-    GradeField& f = options.grade;
-    std::string field = g.string("field");
-    if (field == "ramp") {
-      f.kind = GradeField::Kind::kRamp;
-      f.axis = g.direction_or("axis", Vec3d{0, 0, 1});
-      f.from_mm = g.number("from_mm");
-      f.to_mm = g.number("to_mm");
-      if (f.from_mm == f.to_mm) g.fail("to_mm", "expected a value different from from_mm");
-    } else if (field == "points") {
-      f.kind = GradeField::Kind::kPoints;
-      f.points_mm = g.vec3_list("points_mm");
-      if (f.points_mm.empty()) g.fail("points_mm", "expected at least one point");
-      f.falloff_mm = g.positive_length("falloff_mm");
-    } else if (field == "depth") {
-      f.kind = GradeField::Kind::kDepth;
-      f.depth_mm = g.positive_length("depth_mm");
-      if (!fitted) g.fail("field", "a depth grade needs \"fit_to\": the hull it is measured in");
-    } else {
-      g.fail("field", "expected \"ramp\", \"points\" or \"depth\", got \"" + field + "\"");
-    }
+    options.grade = parse_grade_field(g, fitted ? "" : "a depth grade needs \"fit_to\": the hull it is measured in");
   }
   if (radius_given) options.radius_mm = o.positive_length("strut_radius_mm");
   else if (o.has("strut_radius_mm")) o.fail("strut_radius_mm", "give the radii in \"grade\" when grading the radius");

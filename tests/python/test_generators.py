@@ -144,3 +144,31 @@ def test_lacunar_face_rules_and_measures():
     assert 1 < m["box_counting"]["region_dimension"] <= 2.05
     with pytest.raises(ValueError, match="level"):
         lacuna.bcifs_measure(face={"boundary": "C2 B2 C2 B2 C2 B2"}, radius_mm=8, level=-1)
+
+
+def test_bcifs_volume_measure_counts_volumes_and_sections():
+    # A plain cube: 6^i cells, volumes (1 - 0.5^3)^i of the cube; at level 1 its middle sections are the square less
+    # the lacuna's (half the edge) square, sampled at the pixel centres of the grid's square (the cube's side plus
+    # sqrt(2)/128 of it each end).
+    m = lacuna.bcifs_volume_measure(last=1, cell="hexahedron", edge_mm=10, walls="plain", interior="plain",
+                                    lacuna_scale=0.5)
+    assert list(m["topology"][0]["cells"]) == [1, 6]
+    assert list(m["topology"][0]["lacunas"]) == [0, 1]
+    assert abs(m["volume_mm3"][1] - 875) < 1e-9
+    assert m["geometry_levels"] == (0, 1)
+    side = 10 * (1 + 2 * math.sqrt(2) / 128)
+    pixel = side / 1024
+    origin = -5 - 10 * math.sqrt(2) / 128
+
+    def centres(lo, hi):
+        return sum(1 for i in range(1024) if lo <= origin + (i + 0.5) * pixel <= hi)
+
+    expected = centres(-5, 5) ** 2 - centres(-2.5, 2.5) ** 2
+    assert [s["axis"] for s in m["sections"]] == ["x", "y", "z"]
+    for s in m["sections"]:
+        assert s["mask"].shape == (1024, 1024) and s["mask"].dtype == np.uint8
+        assert abs(s["at_mm"]) < 1e-6
+        assert int(s["mask"].sum()) == expected
+    # The voxel centres inside, times a voxel, are the volume but for voxels within half a diagonal of the surface.
+    assert abs(m["box_counting"]["fill"] * side**3 - 875) <= m["surface_mm2"][1] * side / 256 * math.sqrt(3)
+    assert 2.5 < m["box_counting"]["region_dimension"] <= 3.0

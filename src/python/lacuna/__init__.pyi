@@ -436,6 +436,7 @@ def bcifs_infill(
     cell_mm: float = ...,
     level: int = ...,
     equal_lacunas: bool = ...,
+    grade: Mapping[str, Any] = ...,
     walls: Literal["lacunar", "plain"] = ...,
     edge: str = ...,
     params: str = ...,
@@ -508,3 +509,6 @@ def voronoi_walls(
 def bcifs_rules(boundary: str, params: str = "C2 B2 B2", algorithm: str = "A1", delay: int = 1) -> Dict[str, Any]: ...
 def bcifs_measure(levels: Tuple[int, int] = (0, 4), **plate: Any) -> Dict[str, Any]:
     """The keys of a bcifs_plate input; per face N^C_i, N^L_i, R_i, R; areas, perimeters, box counting."""
+def bcifs_volume_measure(last: int = 3, **volume: Any) -> Dict[str, Any]:
+    """The keys of a bcifs_volume input; per cell N^C_i, N^L_i, R_i, R; volumes, surfaces, tunnels, genus;
+    3D box counting and the three middle sections (1024 x 1024 uint8 masks)."""
