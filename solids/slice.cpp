@@ -18,6 +18,7 @@ std::vector<float> sample_layer(const Volume& volume, double z_mm, const LayerGr
   std::vector<float> out(grid.pixels(), float(volume.band_mm()));
   if (volume.empty()) return out;
   const double inv_h = 1.0 / volume.voxel_size_mm();
+  const float on_surface = float(1e-5 * volume.voxel_size_mm());
   tbb::parallel_for(tbb::blocked_range<int>(0, grid.height, 8), [&](const tbb::blocked_range<int>& rows) {
     openvdb::FloatGrid::ConstAccessor accessor = volume.impl().grid->getConstAccessor();
     for (int j = rows.begin(); j < rows.end(); ++j) {
@@ -25,7 +26,8 @@ std::vector<float> sample_layer(const Volume& volume, double z_mm, const LayerGr
       float* row = out.data() + size_t(j) * size_t(grid.width);
       for (int i = 0; i < grid.width; ++i) {
         const openvdb::Vec3d index((grid.origin_mm.x + i * grid.pixel_mm) * inv_h, y, z_mm * inv_h);
-        row[i] = openvdb::tools::BoxSampler::sample(accessor, index);
+        const float d = openvdb::tools::BoxSampler::sample(accessor, index);
+        row[i] = std::abs(d) < on_surface ? -on_surface : d;
       }
     }
   });

@@ -11,7 +11,9 @@ namespace lacuna {
 
 // The signed distance (mm, negative inside) at the centre of every pixel of `grid` in the plane
 // z = z_mm, row j = 0 first, trilinear between voxel centres (beyond the narrow band: +band outside,
-// -band inside). Rows in parallel; identical for any thread count.
+// -band inside). A value within 1e-5 voxel of 0 (a point on the surface, where rounding picks the
+// sign: a horizontal face on the layer's plane) reads -1e-5 voxel: on the surface counts as inside,
+// everywhere alike. Rows in parallel; identical for any thread count.
 std::vector<float> sample_layer(const Volume& volume, double z_mm, const LayerGrid& grid);
 
 // The box of the solid (mm): the union of the balls the inside voxels' distances guarantee to be

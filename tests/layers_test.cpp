@@ -319,6 +319,30 @@ TEST(Slice, PngStackReadsBackToTheReportedAreas) {
   }
 }
 
+// A box from z = -2.7 to 0.75 at 0.1 mm layers from its bottom: the layer at z = 0.75 lies on its top face.
+// There the surface is parallel to the plane and the samples are rounding noise about 0; the image and the
+// contours must read them alike (they once read a half-covered image against inside contours, and the layer
+// failed its check). Below the top, every layer is the 4 x 4 mm square within the interpolation's rim.
+TEST(Slice, AFaceOnALayersPlaneReadsAlikeInImageAndContours) {
+  TempDir dir;
+  const fs::path recipe = dir / "box.json";
+  write_file(recipe, R"({"lacuna_recipe": 1, "name": "box", "voxel_size_mm": 0.1,
+      "inputs": {"b": {"type": "box", "min_mm": [-2, -2, -2.7], "max_mm": [2, 2, 0.75]}},
+      "outputs": [{"of": "b", "file": "b.stl"}]})");
+  SliceOptions options;
+  options.layer_mm = 0.1;
+  for (const char* out : {"box.cli", "box.zip"}) {
+    const SliceReport r = slice_recipe(recipe.string(), (dir / out).string(), options);
+    ASSERT_TRUE(r.valid) << r.problems.front();
+    ASSERT_EQ(r.layers.size(), 35u);
+    const LayerFigures& top = r.layers.back();
+    EXPECT_NEAR(top.z_mm, 0.75, 1e-6);
+    EXPECT_NEAR(top.image_area_mm2, top.contour_area_mm2, 0.5 * 0.1 * top.contour_length_mm);
+    for (size_t k = 0; k + 1 < r.layers.size(); ++k)
+      EXPECT_NEAR(r.layers[k].contour_area_mm2, 16, 0.5 * 0.1 * 16) << k;
+  }
+}
+
 TEST(Slice, IdenticalBytesForAnyThreadCount) {
   TempDir dir;
   const std::string recipe = sphere_recipe(dir, 2.5, 0.05);

@@ -48,10 +48,17 @@ std::vector<uint8_t> coverage_image(const std::vector<float>& distance, const La
                         (double(std::min(i + 1, w - 1) - std::max(i - 1, 0)) * px);
       const double gy = (at(i, std::min(j + 1, h - 1)) - at(i, std::max(j - 1, 0))) /
                         (double(std::min(j + 1, h - 1) - std::max(j - 1, 0)) * py);
-      const double g = std::max(std::hypot(gx, gy), 1e-3);
+      const double g = std::hypot(gx, gy);
+      uint8_t& v = image[size_t(j) * size_t(w) + size_t(i)];
+      if (!(g > 1e-3)) {
+        // The surface parallel to the layer here (a horizontal face on the layer's plane): no crossing to place
+        // within the pixel, only a side; the contours' reading (inside where d < 0) decides, as it does for them.
+        v = d < 0 ? 255 : 0;
+        continue;
+      }
       // The pixel's width across the boundary (its normal along the gradient).
-      const double across = g > 1e-3 ? (std::abs(gx) * px + std::abs(gy) * py) / g : px;
-      image[size_t(j) * size_t(w) + size_t(i)] = uint8_t(std::lround(255 * std::clamp(0.5 - d / (g * across), 0.0, 1.0)));
+      const double across = (std::abs(gx) * px + std::abs(gy) * py) / g;
+      v = uint8_t(std::lround(255 * std::clamp(0.5 - d / (g * across), 0.0, 1.0)));
     }
   }
   return image;
