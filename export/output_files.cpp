@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <mutex>
 #include <stdexcept>
+#include <unordered_set>
 
 #include "errors.h"
 
@@ -48,6 +49,15 @@ void untrack(const std::string& path) {
       u.paths.erase(u.paths.begin() + long(i));
       return;
     }
+}
+
+// Untracks many paths in one pass (a job may stage thousands of layers).
+void untrack_all(const std::unordered_set<std::string>& paths) {
+  Unfinished& u = unfinished();
+  std::lock_guard<std::mutex> lock(u.mutex);
+  u.paths.erase(std::remove_if(u.paths.begin(), u.paths.end(),
+                               [&](const std::pair<std::string, bool>& p) { return paths.count(p.first) > 0; }),
+                u.paths.end());
 }
 
 // "<dir>/.<name>.tmp-<pid>-<counter>": hidden, in the same directory (so that the rename is
@@ -91,9 +101,7 @@ std::string OutputTransaction::stage(const std::string& final_path) {
   if (final_path.empty() || std::filesystem::path(final_path).filename().empty()) {
     throw InvalidInput("'" + final_path + "' is not a file name");
   }
-  for (const Entry& entry : entries_) {
-    if (entry.final_path == final_path) throw InvalidInput("'" + final_path + "' is written twice");
-  }
+  if (!finals_.insert(final_path).second) throw InvalidInput("'" + final_path + "' is written twice");
   entries_.push_back({temporary_path(final_path), final_path});
   track(entries_.back().temp_path, false);
   return entries_.back().temp_path;
@@ -102,25 +110,28 @@ std::string OutputTransaction::stage(const std::string& final_path) {
 void OutputTransaction::commit() {
   if (done_) throw std::logic_error("OutputTransaction::commit after commit or rollback");
   done_ = true;
+  // A temporary renamed is gone: removing it again (an interrupt before the untracking below) does nothing.
+  std::unordered_set<std::string> temporaries;
+  for (const Entry& entry : entries_) temporaries.insert(entry.temp_path);
   for (size_t i = 0; i < entries_.size(); ++i) {
     if (std::rename(entries_[i].temp_path.c_str(), entries_[i].final_path.c_str()) != 0) {
       int error = errno;
-      for (size_t j = i; j < entries_.size(); ++j) {
-        std::remove(entries_[j].temp_path.c_str());
-        untrack(entries_[j].temp_path);
-      }
+      for (size_t j = i; j < entries_.size(); ++j) std::remove(entries_[j].temp_path.c_str());
+      untrack_all(temporaries);
       throw IoError("cannot move the new '" + entries_[i].final_path + "' into place: " + std::strerror(error));
     }
-    untrack(entries_[i].temp_path);
   }
+  untrack_all(temporaries);
 }
 
 void OutputTransaction::rollback() {
   done_ = true;
+  std::unordered_set<std::string> temporaries;
   for (const Entry& entry : entries_) {
     std::remove(entry.temp_path.c_str());
-    untrack(entry.temp_path);
+    temporaries.insert(entry.temp_path);
   }
+  untrack_all(temporaries);
 }
 
 void write_whole_file(const std::string& path, const std::string& bytes) {

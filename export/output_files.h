@@ -5,6 +5,7 @@
 #pragma once
 
 #include <string>
+#include <unordered_set>
 #include <utility>
 #include <vector>
 
@@ -41,6 +42,7 @@ class OutputTransaction {
     std::string final_path;
   };
   std::vector<Entry> entries_;
+  std::unordered_set<std::string> finals_;  // the final paths staged, to refuse one written twice
   bool done_ = false;
 };
 

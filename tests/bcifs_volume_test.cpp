@@ -66,7 +66,7 @@ std::pair<int, int> faces_on_plane(const VolumeLevel& level, double x) {
 
 double total_volume(const VolumeLevel& level, const VolumeSpec& spec) {
   double v = 0;
-  for (const VolumeCell& c : level.cells) v += cell_volume(level, c, spec);
+  for (const VolumeCell& c : level.cells) v += cell_volume(c, spec);
   return v;
 }
 
@@ -297,11 +297,11 @@ TEST(BcifsVolume, LastLacunaScalesBringLacunasOfCellsVarying4xWithin1_5) {
     const VolumeLevel after = realize_volume(rules, spec, level, options);
     std::map<std::array<double, 3>, double> filled;  // by apex: the sub-cells' volume
     for (const VolumeCell& cell : after.cells)
-      if (cell.root < 0) filled[{cell.base_apex.x, cell.base_apex.y, cell.base_apex.z}] += cell_volume(after, cell, spec);
+      if (cell.root < 0) filled[{cell.base_apex.x, cell.base_apex.y, cell.base_apex.z}] += cell_volume(cell, spec);
     std::vector<double> log_sum(edges.size(), 0.0), count(edges.size(), 0.0);
     for (const VolumeCell& cell : before.cells) {
       if (cell.delay != 1) continue;
-      const double lacuna = cell_volume(before, cell, spec) - filled.at({cell.apex.x, cell.apex.y, cell.apex.z});
+      const double lacuna = cell_volume(cell, spec) - filled.at({cell.apex.x, cell.apex.y, cell.apex.z});
       log_sum[size_t(cell.origin)] += std::log(std::cbrt(lacuna));
       count[size_t(cell.origin)] += 1;
     }

@@ -624,8 +624,7 @@ VolumeLevel realize_volume(const VolumeRules& rules, const VolumeSpec& spec, int
   return level;
 }
 
-double cell_volume(const VolumeLevel& level, const VolumeCell& cell, const VolumeSpec& spec) {
-  (void)level;
+double cell_volume(const VolumeCell& cell, const VolumeSpec& spec) {
   if (cell.root >= 0) {
     const Polyhedron& p = spec.cells[size_t(cell.root)].shape;
     double v = 0;
@@ -766,7 +765,7 @@ double level_shrink(const VolumeSpec& spec, int cell, const VolumeGeometryOption
   auto mean_size = [&](int level) {
     const VolumeLevel l = realize_volume(rules, alone, level, common);
     double sum = 0;
-    for (const VolumeCell& c : l.cells) sum += std::log(std::cbrt(cell_volume(l, c, alone)));
+    for (const VolumeCell& c : l.cells) sum += std::log(std::cbrt(cell_volume(c, alone)));
     return std::exp(sum / double(l.cells.size()));
   };
   return mean_size(1) / mean_size(2);
@@ -802,7 +801,7 @@ std::vector<double> last_lacuna_sizes(const VolumeRules& rules, const VolumeSpec
     if (cell.delay != 1) continue;
     const double s =
         options.last_lacuna_scale.empty() ? options.lacuna_scale : options.last_lacuna_scale[size_t(cell.origin)];
-    log_sum[size_t(cell.origin)] += std::log(s * std::cbrt(cell_volume(before, cell, spec)));
+    log_sum[size_t(cell.origin)] += std::log(s * std::cbrt(cell_volume(cell, spec)));
     count[size_t(cell.origin)] += 1;
   }
   std::vector<double> out;
@@ -839,7 +838,7 @@ VolumeMeasures volume_measures(const VolumeRules& rules, const VolumeSpec& spec,
     m.lacunas.push_back(lacunas);
     m.genus.push_back(tunnels - lacunas);
     double v = 0, a = 0;
-    for (const VolumeCell& cell : level.cells) v += cell_volume(level, cell, spec);
+    for (const VolumeCell& cell : level.cells) v += cell_volume(cell, spec);
     for (size_t f = 0; f < level.faces.size(); ++f)
       if (level.owners[f] == 1) a += norm(newell(level.faces[f].polygon)) / 2;
     m.volume.push_back(v);

@@ -184,7 +184,7 @@ VolumeLevel realize_volume(const VolumeRules& rules, const VolumeSpec& spec, int
                            const VolumeGeometryOptions& options = {});
 
 // The volume of one cell's region (exact for planar faces).
-double cell_volume(const VolumeLevel& level, const VolumeCell& cell, const VolumeSpec& spec);
+double cell_volume(const VolumeCell& cell, const VolumeSpec& spec);
 
 // The level's cells as convex pieces for the rasterizer: a root polyhedron as it is, a frustum over a convex
 // base as one cell, one over a non-convex base as the frusta of its base's ear-clipped triangles. Every piece is

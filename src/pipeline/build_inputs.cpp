@@ -605,7 +605,7 @@ class Builder {
     report.cell_types = rules.cells.size();
     report.face_types = rules.faces.rules.size();
     report.shared_faces = rules.shared.size();
-    for (const bcifs::VolumeCell& c : cells.cells) report.volume_mm3 += bcifs::cell_volume(cells, c, spec);
+    for (const bcifs::VolumeCell& c : cells.cells) report.volume_mm3 += bcifs::cell_volume(c, spec);
     for (ConvexCells& pieces : bcifs::convex_pieces(cells, spec)) {
       report.pieces += pieces.size();
       out_.geometry.cells.push_back(std::move(pieces));

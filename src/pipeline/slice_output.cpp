@@ -306,6 +306,21 @@ void LayerSlicer::skip_to(double z_mm) {
 
 namespace {
 
+// Slab i's own part is [cuts[i], cuts[i + 1]), cuts[i] = bottom + i height (each computed, not summed, so that
+// neighbours and every estimate agree to the bit), up to the first cut at or above `top`.
+std::vector<double> slab_cuts(double bottom, double top, double height) {
+  std::vector<double> cuts = {bottom};
+  while (cuts.back() < top) cuts.push_back(bottom + double(cuts.size()) * height);
+  return cuts;
+}
+
+// The slabs the cuts make, each grown by the halo below and above.
+std::vector<ZSlab> with_halo(const std::vector<double>& cuts, double halo) {
+  std::vector<ZSlab> slabs;
+  for (size_t i = 0; i + 1 < cuts.size(); ++i) slabs.push_back({cuts[i] - halo, cuts[i + 1] + halo});
+  return slabs;
+}
+
 template <typename T>
 void put(std::string& out, const T& v) {
   out.append(reinterpret_cast<const char*>(&v), sizeof v);
@@ -524,11 +539,7 @@ SliceReport slice_recipe(Recipe recipe, const std::string& output, const SliceOp
     bottom = std::floor((extent.box.min.z - band - h) / leaf) * leaf;
     top = extent.box.max.z + band + 2 * h;
     whole = std::ceil((top - bottom) / leaf) * leaf;
-    auto slabs_of = [&](double height) {
-      std::vector<ZSlab> slabs;
-      for (double lo = bottom; lo < top; lo += height) slabs.push_back({lo - halo, lo + height + halo});
-      return slabs;
-    };
+    auto slabs_of = [&](double height) { return with_halo(slab_cuts(bottom, top, height), halo); };
     if (options.slab_mm > 0) {
       slab_height = std::ceil(options.slab_mm / leaf - 1e-9) * leaf;
     } else if (estimator->bytes() > budget) {
@@ -549,13 +560,10 @@ SliceReport slice_recipe(Recipe recipe, const std::string& output, const SliceOp
   if (ranks && (slab_height == 0 || slab_height * rank_count > whole))
     slab_height = std::ceil(whole / leaf / rank_count) * leaf;
   if (slab_height >= whole) slab_height = 0;
-  // Slab i's own part is [cuts[i], cuts[i + 1]), computed once so that neighbours agree to the bit;
-  // the first reaches down and the last up without end (their layers are theirs).
-  std::vector<double> cuts = {bottom};
-  while (slab_height > 0 && cuts.back() < top) cuts.push_back(bottom + double(cuts.size()) * slab_height);
-  if (slab_height == 0) cuts.push_back(bottom + whole);
-  std::vector<ZSlab> slabs;
-  for (size_t i = 0; i + 1 < cuts.size(); ++i) slabs.push_back({cuts[i] - halo, cuts[i + 1] + halo});
+  // The first slab reaches down and the last up without end (their layers are theirs).
+  const std::vector<double> cuts =
+      slab_height > 0 ? slab_cuts(bottom, top, slab_height) : std::vector<double>{bottom, bottom + whole};
+  const std::vector<ZSlab> slabs = with_halo(cuts, halo);
   const size_t first_slab = slabs.size() * size_t(me) / size_t(rank_count);
   const size_t end_slab = slabs.size() * size_t(me + 1) / size_t(rank_count);
   auto slab_lo = [&](size_t i) { return i == 0 ? -std::numeric_limits<double>::infinity() : cuts[i]; };
