@@ -103,6 +103,7 @@ std::string OutputTransaction::stage(const std::string& final_path) {
   }
   if (!finals_.insert(final_path).second) throw InvalidInput("'" + final_path + "' is written twice");
   entries_.push_back({temporary_path(final_path), final_path});
+  temporaries_.insert(entries_.back().temp_path);
   track(entries_.back().temp_path, false);
   return entries_.back().temp_path;
 }
@@ -111,27 +112,21 @@ void OutputTransaction::commit() {
   if (done_) throw std::logic_error("OutputTransaction::commit after commit or rollback");
   done_ = true;
   // A temporary renamed is gone: removing it again (an interrupt before the untracking below) does nothing.
-  std::unordered_set<std::string> temporaries;
-  for (const Entry& entry : entries_) temporaries.insert(entry.temp_path);
   for (size_t i = 0; i < entries_.size(); ++i) {
     if (std::rename(entries_[i].temp_path.c_str(), entries_[i].final_path.c_str()) != 0) {
       int error = errno;
       for (size_t j = i; j < entries_.size(); ++j) std::remove(entries_[j].temp_path.c_str());
-      untrack_all(temporaries);
+      untrack_all(temporaries_);
       throw IoError("cannot move the new '" + entries_[i].final_path + "' into place: " + std::strerror(error));
     }
   }
-  untrack_all(temporaries);
+  untrack_all(temporaries_);
 }
 
 void OutputTransaction::rollback() {
   done_ = true;
-  std::unordered_set<std::string> temporaries;
-  for (const Entry& entry : entries_) {
-    std::remove(entry.temp_path.c_str());
-    temporaries.insert(entry.temp_path);
-  }
-  untrack_all(temporaries);
+  for (const Entry& entry : entries_) std::remove(entry.temp_path.c_str());
+  untrack_all(temporaries_);
 }
 
 void write_whole_file(const std::string& path, const std::string& bytes) {

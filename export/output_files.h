@@ -22,7 +22,8 @@ class OutputTransaction {
   // "<dir>/.<name>.tmp-<pid>-<counter>".
   std::string stage(const std::string& final_path);
   // Renames every staged file to its final name. Throws IoError if a rename fails (the files
-  // already renamed stay; the rest are removed).
+  // already renamed stay; the rest are removed). The temporaries are untracked once all are renamed: an
+  // interrupt meanwhile removes those not yet renamed (a renamed one is gone under its temporary name).
   void commit();
   // Removes every staged temporary file.
   void rollback();
@@ -42,7 +43,9 @@ class OutputTransaction {
     std::string final_path;
   };
   std::vector<Entry> entries_;
-  std::unordered_set<std::string> finals_;  // the final paths staged, to refuse one written twice
+  std::unordered_set<std::string> finals_;       // the final paths staged, to refuse one written twice
+  std::unordered_set<std::string> temporaries_;  // their temporaries, untracked in one pass (commit and rollback
+                                                 // allocate nothing: rollback runs in the destructor)
   bool done_ = false;
 };
 

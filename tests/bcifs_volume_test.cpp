@@ -263,7 +263,7 @@ TEST(BcifsVolume, DelaysBySizeEqualizeTheLacunas) {
                                         false, "B2", "B2 B2 B2"));
       if (delayed) spec.cells.back().delay = delays[c];
     }
-    const std::vector<double> sizes = last_lacuna_sizes(build_volume_rules(spec), spec, 3);
+    const std::vector<double> sizes = last_lacuna_sizes(build_volume_rules(spec), spec, 3).mean_mm;
     for (double s : sizes) EXPECT_GT(s, 0);
     return *std::max_element(sizes.begin(), sizes.end()) / *std::min_element(sizes.begin(), sizes.end());
   };
@@ -273,79 +273,106 @@ TEST(BcifsVolume, DelaysBySizeEqualizeTheLacunas) {
   EXPECT_LT(spread({1, shrink, shrink * shrink}, true), 1.5);
 }
 
-// Cells of edges varying 4x, with plain walls (each subdivision leaves a cell's lacuna exactly its region scaled,
-// and its sub-cells fill the rest): each lacuna the last level makes is measured from the volumes alone, as the
-// cube root of its parent's volume less its sub-cells' (found by their apex: the parent's centre), and averaged
-// geometrically per cell of the spec. Delays by size leave them more than 1.5 apart; the last lacuna scales bring
-// them within 1.5.
-TEST(BcifsVolume, LastLacunaScalesBringLacunasOfCellsVarying4xWithin1_5) {
-  const std::vector<double> edges{1, 1.6, 2.5, 4};
-  const int level = 3;
-  VolumeSpec spec;
-  for (size_t c = 0; c < edges.size(); ++c)
-    spec.cells.push_back(uniform_cell(regular_cell(CellKind::kHexahedron, edges[c], {10.0 * double(c), 0, 0}), true));
-  spec.interior.plain = true;
-  const double shrink = level_shrink(spec, 3);
-  EXPECT_GT(shrink, 1.5);
-  const std::vector<int> delays = delays_for_sizes(edges, level, shrink);
-  for (size_t c = 0; c < edges.size(); ++c) spec.cells[c].delay = delays[c];
-  const VolumeRules rules = build_volume_rules(spec);
-  auto measured = [&](const VolumeGeometryOptions& options) {
-    VolumeGeometryOptions common = options;  // the last scales belong to the last subdivision only
-    common.last_lacuna_scale.clear();
-    const VolumeLevel before = realize_volume(rules, spec, level - 1, common);
-    const VolumeLevel after = realize_volume(rules, spec, level, options);
-    std::map<std::array<double, 3>, double> filled;  // by apex: the sub-cells' volume
-    for (const VolumeCell& cell : after.cells)
-      if (cell.root < 0) filled[{cell.base_apex.x, cell.base_apex.y, cell.base_apex.z}] += cell_volume(cell, spec);
-    std::vector<double> log_sum(edges.size(), 0.0), count(edges.size(), 0.0);
-    for (const VolumeCell& cell : before.cells) {
-      if (cell.delay != 1) continue;
-      const double lacuna = cell_volume(cell, spec) - filled.at({cell.apex.x, cell.apex.y, cell.apex.z});
-      log_sum[size_t(cell.origin)] += std::log(std::cbrt(lacuna));
-      count[size_t(cell.origin)] += 1;
-    }
-    std::vector<double> sizes;
-    for (size_t c = 0; c < edges.size(); ++c) sizes.push_back(std::exp(log_sum[c] / count[c]));
-    return *std::max_element(sizes.begin(), sizes.end()) / *std::min_element(sizes.begin(), sizes.end());
-  };
-  VolumeGeometryOptions options;
-  const double delayed_only = measured(options);
-  EXPECT_GT(delayed_only, 1.5);
-  options.last_lacuna_scale = lacuna_scales_for_sizes(last_lacuna_sizes(rules, spec, level, options), 0.5);
-  for (double s : options.last_lacuna_scale) {
-    EXPECT_GE(s, 0.5 / 3);
-    EXPECT_LE(s, 0.5);
+// The lacunas the last subdivision makes, one per parent cell that subdivides then, from the realized geometry:
+// the parent's volume (level - 1) and the scale its sub-cells show (an inner corner's distance to the parent's
+// centre over its outer corner's), size = scale * cbrt(volume). With plain walls the parent's volume less its
+// sub-cells' is the lacuna's volume, which `from_volumes` checks against scale^3 * volume.
+struct MeasuredLacuna {
+  int origin = -1;
+  double size = 0;
+};
+std::vector<MeasuredLacuna> measured_lacunas(const VolumeRules& rules, const VolumeSpec& spec, int level,
+                                             const VolumeGeometryOptions& options, bool from_volumes) {
+  VolumeGeometryOptions common = options;  // the last scales belong to the last subdivision only
+  common.last_lacuna_mm.clear();
+  const VolumeLevel before = realize_volume(rules, spec, level - 1, common);
+  const VolumeLevel after = realize_volume(rules, spec, level, options);
+  std::map<std::array<double, 3>, std::pair<double, double>> children;  // by apex: sub-cells' volume, scale
+  for (const VolumeCell& cell : after.cells) {
+    if (cell.root >= 0 || cell.delay != 1 || cell.base.empty()) continue;
+    auto& [volume, scale] = children[{cell.base_apex.x, cell.base_apex.y, cell.base_apex.z}];
+    volume += cell_volume(cell, spec);
+    const Vec3d inner = cell.base_apex * (1 - cell.base_scale) + cell.base[0] * cell.base_scale;  // as realized
+    scale = norm(inner - cell.base_apex) / norm(cell.base[0] - cell.base_apex);
   }
-  EXPECT_LT(measured(options), 1.5);
-  // last_lacuna_sizes reads the scales too: one size for all (none clamped here).
-  const std::vector<double> sizes = last_lacuna_sizes(rules, spec, level, options);
-  EXPECT_NEAR(*std::max_element(sizes.begin(), sizes.end()) / *std::min_element(sizes.begin(), sizes.end()), 1, 1e-9);
-  // The same with lacunar (B2) walls: the lacunas' sizes as last_lacuna_sizes reads them.
-  VolumeSpec walls = spec;
-  for (CellSpec& c : walls.cells) c = [&] {
-      CellSpec w = uniform_cell(c.shape, false);
-      w.delay = c.delay;
-      return w;
-    }();
-  walls.interior = InteriorFaces{};
-  const VolumeRules wall_rules = build_volume_rules(walls);
-  VolumeGeometryOptions equal;
-  const std::vector<double> before = last_lacuna_sizes(wall_rules, walls, level, equal);
-  equal.last_lacuna_scale = lacuna_scales_for_sizes(before, 0.5);
-  const std::vector<double> after = last_lacuna_sizes(wall_rules, walls, level, equal);
-  EXPECT_LT(*std::max_element(after.begin(), after.end()) / *std::min_element(after.begin(), after.end()), 1.5);
+  std::vector<MeasuredLacuna> out;
+  for (const VolumeCell& cell : before.cells) {
+    if (cell.delay != 1) continue;
+    const auto& [filled, scale] = children.at({cell.apex.x, cell.apex.y, cell.apex.z});
+    const double volume = cell_volume(cell, spec);
+    if (from_volumes) {
+      EXPECT_NEAR(volume - filled, scale * scale * scale * volume, 1e-9 * volume);
+    }
+    out.push_back({cell.origin, scale * std::cbrt(volume)});
+  }
+  return out;
 }
 
-// Two cubes sharing the face x = 5 with last lacuna scales 0.3 and 0.7: the shared face's sub-faces are still one
-// set, owned by both cubes' cells, and each cube keeps its own volume (1 - s^3) per plain level.
-TEST(BcifsVolume, LastLacunaScalesKeepSharedFacesShared) {
+// Largest over smallest of the lacunas, and of their geometric means per cell of the spec.
+std::pair<double, double> spreads(const std::vector<MeasuredLacuna>& lacunas, size_t cells) {
+  std::vector<double> log_sum(cells, 0.0), count(cells, 0.0);
+  double lo = HUGE_VAL, hi = 0;
+  for (const MeasuredLacuna& l : lacunas) {
+    log_sum[size_t(l.origin)] += std::log(l.size);
+    count[size_t(l.origin)] += 1;
+    lo = std::min(lo, l.size);
+    hi = std::max(hi, l.size);
+  }
+  double mlo = HUGE_VAL, mhi = 0;
+  for (size_t c = 0; c < cells; ++c) {
+    const double m = std::exp(log_sum[c] / count[c]);
+    mlo = std::min(mlo, m);
+    mhi = std::max(mhi, m);
+  }
+  return {hi / lo, mhi / mlo};
+}
+
+// Cells of edges varying 4x (1, 1.6, 2.5, 4), delayed by size, their last lacunas measured from the geometry:
+// delays alone leave them more than 1.5 apart (also their geometric means per cell); with one last lacuna size
+// for all (the smallest, each cell scaling its own lacuna down) every lacuna is within 1.5 of every other, with
+// plain walls and with Bezier (B2) walls.
+TEST(BcifsVolume, LastLacunaSizeBringsLacunasOfCellsVarying4xWithin1_5) {
+  const std::vector<double> edges{1, 1.6, 2.5, 4};
+  const int level = 3;
+  for (bool plain : {true, false}) {
+    VolumeSpec spec;
+    for (size_t c = 0; c < edges.size(); ++c)
+      spec.cells.push_back(
+          uniform_cell(regular_cell(CellKind::kHexahedron, edges[c], {10.0 * double(c), 0, 0}), plain));
+    spec.interior.plain = plain;
+    const double shrink = level_shrink(spec, 3);
+    EXPECT_GT(shrink, 1.5);
+    const std::vector<int> delays = delays_for_sizes(edges, level, shrink);
+    for (size_t c = 0; c < edges.size(); ++c) spec.cells[c].delay = delays[c];
+    const VolumeRules rules = build_volume_rules(spec);
+    VolumeGeometryOptions options;
+    const auto [each_delayed, cells_delayed] = spreads(measured_lacunas(rules, spec, level, options, plain), 4);
+    EXPECT_GT(each_delayed, 1.5) << plain;
+    EXPECT_GT(cells_delayed, 1.5) << plain;
+    const LastLacunas before = last_lacuna_sizes(rules, spec, level, options);
+    const double smallest = *std::min_element(before.smallest_mm.begin(), before.smallest_mm.end());
+    options.last_lacuna_mm.assign(edges.size(), smallest);
+    const LastLacunas after = last_lacuna_sizes(rules, spec, level, options);
+    EXPECT_GE(after.min_scale, 0.5 / 3);
+    EXPECT_LE(after.max_scale, 0.5);
+    const auto [each, cells] = spreads(measured_lacunas(rules, spec, level, options, plain), 4);
+    EXPECT_LT(each, 1.5) << plain;
+    EXPECT_LT(cells, 1.5) << plain;
+  }
+}
+
+// Two cubes of edge 5 sharing the face x = 5 with last lacuna sizes 1.5 and 2 mm (scales 0.3 and 0.4 at level 1):
+// the shared face's sub-faces are still one set, owned by both cubes' cells; a plain cube of edge 2 whose level-1
+// cells (volume 7/6 each) take the scale 0.3 at level 2 keeps 8 (7/8) (1 - 0.3^3).
+TEST(BcifsVolume, LastLacunaSizesKeepSharedFacesShared) {
   VolumeSpec spec;
   spec.cells.push_back(uniform_cell(regular_cell(CellKind::kHexahedron, 5, {2.5, 2.5, 2.5}), false));
   spec.cells.push_back(uniform_cell(regular_cell(CellKind::kHexahedron, 5, {7.5, 2.5, 2.5}), false));
   const VolumeRules rules = build_volume_rules(spec);
   VolumeGeometryOptions same, own;
-  own.last_lacuna_scale = {0.3, 0.7};
+  own.last_lacuna_mm = {1.5, 2.0};
+  EXPECT_NEAR(last_lacuna_sizes(rules, spec, 1, own).min_scale, 0.3, 1e-12);
+  EXPECT_NEAR(last_lacuna_sizes(rules, spec, 1, own).max_scale, 0.4, 1e-12);
   for (int level = 1; level <= 2; ++level) {
     const auto [on_plane, twice] = faces_on_plane(realize_volume(rules, spec, level, own), 5.0);
     EXPECT_EQ(faces_on_plane(realize_volume(rules, spec, level, same), 5.0), std::make_pair(on_plane, twice));
@@ -355,11 +382,11 @@ TEST(BcifsVolume, LastLacunaScalesKeepSharedFacesShared) {
   VolumeSpec plain = plain_spec(CellKind::kHexahedron, 2);
   const VolumeRules plain_rules = build_volume_rules(plain);
   VolumeGeometryOptions last;
-  last.last_lacuna_scale = {0.3};
+  last.last_lacuna_mm = {0.3 * std::cbrt(7.0 / 6)};
   EXPECT_NEAR(total_volume(realize_volume(plain_rules, plain, 2, last), plain), 8 * (1 - 0.125) * (1 - 0.027), 1e-9);
-  last.last_lacuna_scale = {0.3, 0.4};
+  last.last_lacuna_mm = {0.3, 0.4};
   EXPECT_THROW(realize_volume(plain_rules, plain, 2, last), InvalidInput);
-  last.last_lacuna_scale = {1.0};
+  last.last_lacuna_mm = {-1.0};
   EXPECT_THROW(realize_volume(plain_rules, plain, 2, last), InvalidInput);
 }
 

@@ -430,8 +430,9 @@ double volume_lacunas(const VolumeRules& rules, int level) {
 void validate(const VolumeGeometryOptions& options) {
   if (!(options.lacuna_scale > 0 && options.lacuna_scale < 1))
     throw InvalidInput("the cells' lacuna_scale must be in (0, 1), got " + std::to_string(options.lacuna_scale));
-  for (double s : options.last_lacuna_scale)
-    if (!(s > 0 && s < 1)) throw InvalidInput("a cell's last lacuna scale must be in (0, 1), got " + std::to_string(s));
+  for (double size : options.last_lacuna_mm)
+    if (!(size >= 0 && std::isfinite(size)))
+      throw InvalidInput("a cell's last lacuna size must be >= 0 mm, got " + std::to_string(size));
   validate(options.faces);
 }
 
@@ -442,9 +443,9 @@ class Realizer {
  public:
   Realizer(const VolumeRules& rules, const VolumeSpec& spec, const VolumeGeometryOptions& options)
       : rules_(rules), spec_(spec), options_(options) {
-    if (!options.last_lacuna_scale.empty() && options.last_lacuna_scale.size() != spec.cells.size())
-      throw InvalidInput("lacunar volume: " + std::to_string(options.last_lacuna_scale.size()) +
-                         " last lacuna scales for " + std::to_string(spec.cells.size()) + " cells");
+    if (!options.last_lacuna_mm.empty() && options.last_lacuna_mm.size() != spec.cells.size())
+      throw InvalidInput("lacunar volume: " + std::to_string(options.last_lacuna_mm.size()) +
+                         " last lacuna sizes for " + std::to_string(spec.cells.size()) + " cells");
     for (size_t t = 0; t < rules.cells.size(); ++t) ids_[rules.cells[t].cell] = int(t);
   }
 
@@ -482,9 +483,11 @@ class Realizer {
     VolumeLevel out;
     out.level = level.level + 1;
     keys_.clear();
-    const bool own_scales = last && !options_.last_lacuna_scale.empty();
+    const bool own_sizes = last && !options_.last_lacuna_mm.empty();
     for (const VolumeCell& cell : level.cells) {
-      const double s = own_scales ? options_.last_lacuna_scale[size_t(cell.origin)] : options_.lacuna_scale;
+      const double s = own_sizes && cell.delay < 2 ? last_scale(options_.last_lacuna_mm[size_t(cell.origin)],
+                                                                cell_volume(cell, spec_), options_.lacuna_scale)
+                                                   : options_.lacuna_scale;
       if (cell.delay >= 2) {
         VolumeCell child = cell;
         child.delay = cell.delay - 1;
@@ -761,7 +764,7 @@ double level_shrink(const VolumeSpec& spec, int cell, const VolumeGeometryOption
   alone.cells[0].delay = 1;
   const VolumeRules rules = build_volume_rules(alone);
   VolumeGeometryOptions common = options;
-  common.last_lacuna_scale.clear();
+  common.last_lacuna_mm.clear();
   auto mean_size = [&](int level) {
     const VolumeLevel l = realize_volume(rules, alone, level, common);
     double sum = 0;
@@ -788,40 +791,45 @@ std::vector<int> delays_for_sizes(const std::vector<double>& sizes_mm, int level
   return delays;
 }
 
-std::vector<double> last_lacuna_sizes(const VolumeRules& rules, const VolumeSpec& spec, int level,
-                                      const VolumeGeometryOptions& options) {
-  if (level < 1) throw InvalidInput("last_lacuna_sizes: level must be >= 1");
-  if (!options.last_lacuna_scale.empty() && options.last_lacuna_scale.size() != spec.cells.size())
-    throw InvalidInput("last_lacuna_sizes: one last lacuna scale per cell expected");
-  VolumeGeometryOptions before_options = options;  // the last scales belong to the subdivision after `before`
-  before_options.last_lacuna_scale.clear();
-  const VolumeLevel before = realize_volume(rules, spec, level - 1, before_options);
-  std::vector<double> log_sum(spec.cells.size(), 0.0), count(spec.cells.size(), 0.0);
-  for (const VolumeCell& cell : before.cells) {
-    if (cell.delay != 1) continue;
-    const double s =
-        options.last_lacuna_scale.empty() ? options.lacuna_scale : options.last_lacuna_scale[size_t(cell.origin)];
-    log_sum[size_t(cell.origin)] += std::log(s * std::cbrt(cell_volume(cell, spec)));
-    count[size_t(cell.origin)] += 1;
-  }
-  std::vector<double> out;
-  for (size_t c = 0; c < spec.cells.size(); ++c) out.push_back(count[c] > 0 ? std::exp(log_sum[c] / count[c]) : 0.0);
-  return out;
+double last_scale(double size_mm, double volume_mm3, double lacuna_scale) {
+  if (!(size_mm > 0) || !(volume_mm3 > 0)) return lacuna_scale;
+  return std::clamp(size_mm / std::cbrt(volume_mm3), lacuna_scale / 3, lacuna_scale);
 }
 
-std::vector<double> lacuna_scales_for_sizes(const std::vector<double>& sizes_mm, double lacuna_scale) {
-  if (!(lacuna_scale > 0 && lacuna_scale < 1)) throw InvalidInput("lacuna_scales_for_sizes: the scale must be in (0, 1)");
-  std::vector<double> made;
-  for (double l : sizes_mm) {
-    if (!(l >= 0 && std::isfinite(l))) throw InvalidInput("lacuna_scales_for_sizes: sizes must be >= 0");
-    if (l > 0) made.push_back(l);
+LastLacunas last_lacuna_sizes(const VolumeRules& rules, const VolumeSpec& spec, int level,
+                              const VolumeGeometryOptions& options) {
+  if (level < 1) throw InvalidInput("last_lacuna_sizes: level must be >= 1");
+  const size_t n = spec.cells.size();
+  if (!options.last_lacuna_mm.empty() && options.last_lacuna_mm.size() != n)
+    throw InvalidInput("last_lacuna_sizes: one last lacuna size per cell expected");
+  VolumeGeometryOptions before_options = options;  // the last sizes belong to the subdivision after `before`
+  before_options.last_lacuna_mm.clear();
+  const VolumeLevel before = realize_volume(rules, spec, level - 1, before_options);
+  std::vector<double> log_sum(n, 0.0), count(n, 0.0);
+  LastLacunas out;
+  out.smallest_mm.assign(n, HUGE_VAL);
+  out.largest_mm.assign(n, 0.0);
+  out.min_scale = HUGE_VAL;
+  for (const VolumeCell& cell : before.cells) {
+    if (cell.delay != 1) continue;
+    const size_t c = size_t(cell.origin);
+    const double volume = cell_volume(cell, spec);
+    const double s = options.last_lacuna_mm.empty() ? options.lacuna_scale
+                                                     : last_scale(options.last_lacuna_mm[c], volume, options.lacuna_scale);
+    const double size = s * std::cbrt(volume);
+    log_sum[c] += std::log(size);
+    count[c] += 1;
+    out.smallest_mm[c] = std::min(out.smallest_mm[c], size);
+    out.largest_mm[c] = std::max(out.largest_mm[c], size);
+    out.min_scale = std::min(out.min_scale, s);
+    out.max_scale = std::max(out.max_scale, s);
   }
-  std::vector<double> scales(sizes_mm.size(), lacuna_scale);
-  if (made.empty()) return scales;
-  const double target = *std::min_element(made.begin(), made.end());
-  for (size_t c = 0; c < sizes_mm.size(); ++c)
-    if (sizes_mm[c] > 0) scales[c] = std::max(lacuna_scale * target / sizes_mm[c], lacuna_scale / 3);
-  return scales;
+  for (size_t c = 0; c < n; ++c) {
+    out.mean_mm.push_back(count[c] > 0 ? std::exp(log_sum[c] / count[c]) : 0.0);
+    if (!(count[c] > 0)) out.smallest_mm[c] = 0;
+  }
+  if (!(out.max_scale > 0)) out.min_scale = 0;
+  return out;
 }
 
 VolumeMeasures volume_measures(const VolumeRules& rules, const VolumeSpec& spec, int levels,

@@ -139,10 +139,13 @@ double volume_lacunas(const VolumeRules& rules, int level);
 struct VolumeGeometryOptions {
   double lacuna_scale = 0.5;  // the cell's lacuna: the cell scaled about its apex, in (0, 1)
   GeometryOptions faces;      // the faces' rules (gap_fraction, their own lacuna_scale, notch_depth)
-  // Per cell of the spec, or empty: the lacuna scale of its descendants' last subdivision (the one that makes the
-  // level realized); lacuna_scale before it. A cell's own lacuna touches no face it shares with another cell (its
-  // faces subdivide by their face rules alone), so cells may differ here and the assembly stays consistent.
-  std::vector<double> last_lacuna_scale;
+  // Per cell of the spec, or empty: the size (mm) of every lacuna its descendants make in the last subdivision (the
+  // one that makes the level realized), 0 for none. A cell of volume V subdividing then takes the scale
+  // size / cbrt(V), kept within [lacuna_scale / 3, lacuna_scale] (lacunas only shrink, so no wall gets thinner than
+  // lacuna_scale makes it); lacuna_scale before that step. A cell's own lacuna touches no face it shares with
+  // another (its faces subdivide by their face rules alone), so every cell may take its own scale and the assembly
+  // stays consistent.
+  std::vector<double> last_lacuna_mm;
 };
 
 // Throws InvalidInput unless every option is in (0, 1).
@@ -204,19 +207,18 @@ double level_shrink(const VolumeSpec& spec, int cell, const VolumeGeometryOption
 // two cells' within shrink of each other (two sizes that round to one delay). Sizes must be > 0.
 std::vector<int> delays_for_sizes(const std::vector<double>& sizes_mm, int level, double shrink);
 
-// The size of the lacunas the last subdivision makes (level - 1 to level), per cell of the spec: the geometric
-// mean of s * cbrt(volume) over that cell's descendants that subdivide then (s its last lacuna scale); 0 for a
-// cell whose descendants are all still delayed.
-std::vector<double> last_lacuna_sizes(const VolumeRules& rules, const VolumeSpec& spec, int level,
-                                      const VolumeGeometryOptions& options = {});
+// The lacuna scale a cell of volume `volume_mm3` takes in the last subdivision for a lacuna of `size_mm` (0: lacuna_scale).
+double last_scale(double size_mm, double volume_mm3, double lacuna_scale);
 
-// Last lacuna scales that bring the cells' last lacunas to one size, from their sizes at `lacuna_scale`
-// (last_lacuna_sizes without last scales): the target is the smallest size, a cell of size L gets
-// lacuna_scale * target / L, at least lacuna_scale / 3; a cell of size 0 (no lacuna) keeps lacuna_scale. Lacunas
-// only shrink, so no wall is thinner than lacuna_scale makes it (larger scales for the small cells thinned
-// their walls into loose crumbs). Delays by size leave the sizes within about one shrink (3 to 4 for B2 walls) of
-// each other; up to 3 apart they end equal.
-std::vector<double> lacuna_scales_for_sizes(const std::vector<double>& sizes_mm, double lacuna_scale);
+// The lacunas the last subdivision makes (level - 1 to level), per cell of the spec: over its descendants that
+// subdivide then, the geometric mean, the smallest and the largest of scale * cbrt(volume) (their scale as
+// last_lacuna_mm gives it), and the range of those scales; 0 for a cell whose descendants are all still delayed.
+struct LastLacunas {
+  std::vector<double> mean_mm, smallest_mm, largest_mm;
+  double min_scale = 0, max_scale = 0;  // over every cell
+};
+LastLacunas last_lacuna_sizes(const VolumeRules& rules, const VolumeSpec& spec, int level,
+                              const VolumeGeometryOptions& options = {});
 
 // Sampling a level's convex pieces (convex_pieces) for box counting and sections.
 // A cube of size^3 voxels over the pieces' bounding box: its side the box's longest plus a margin of sqrt(2)/128 of
@@ -237,7 +239,7 @@ void mark_voxels(const std::vector<ConvexCells>& pieces, const VoxelGrid& grid, 
 
 // Box counts of a size^3 mask (x fastest, then y, then z) on its cube: eps = 1/4 .. 1/size of the side, N_eps the
 // boxes holding a voxel of the set, or with `boundary` a voxel of the set that has a 6-neighbour outside it or lies
-// on the cube's border. Throws InvalidInput unless size is a power of two >= 4 and mask.size() = size^3.
+// on the cube's border. Throws InvalidInput unless size is a power of two >= 8 and mask.size() = size^3.
 BoxCount box_count_3d(const std::vector<uint8_t>& mask, int size, bool boundary);
 
 // The section of the pieces by the plane where coordinate `axis` (0 x, 1 y, 2 z) equals `value`: pixel centres

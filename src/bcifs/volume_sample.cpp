@@ -127,8 +127,8 @@ void mark_voxels(const std::vector<ConvexCells>& pieces, const VoxelGrid& grid, 
 }
 
 BoxCount box_count_3d(const std::vector<uint8_t>& mask, int size, bool boundary) {
-  if (!power_of_two(size) || size < 4 || mask.size() != size_t(size) * size_t(size) * size_t(size))
-    throw InvalidInput("box_count_3d: expected a size^3 mask, size a power of two >= 4");
+  if (!power_of_two(size) || size < 8 || mask.size() != size_t(size) * size_t(size) * size_t(size))
+    throw InvalidInput("box_count_3d: expected a size^3 mask, size a power of two >= 8 (two box sizes for a slope)");
   const size_t n = size_t(size);
   auto at = [&](size_t i, size_t j, size_t k) { return mask[(k * n + j) * n + i]; };
   // The finest level: the set, or its boundary voxels.

@@ -743,24 +743,21 @@ class Builder {
       throw ResourceLimit(where() + ": " + std::to_string(spec.cells.size()) + " tetrahedra at level " +
                           std::to_string(b.level) + " make " + message_number(cells) + " cells, more than " +
                           message_number(bcifs::kMaxVolumeCells) + "; use larger cell_mm or a lower level");
-    // The lacunas the last level makes, per tetrahedron (those still all delayed make none); with equal_lacunas
-    // each tetrahedron's last lacuna scale brings them down to the smallest of the tetrahedra graded alike.
+    // The lacunas the last level makes (tetrahedra still all delayed make none); with equal_lacunas every one is
+    // brought down to the smallest of those the tetrahedra graded alike make (a cell's own lacuna touches no
+    // face it shares, so each takes its own scale).
     bcifs::VolumeGeometryOptions options = b.options;
-    std::vector<double> lacuna_sizes = bcifs::last_lacuna_sizes(rules, spec, b.level, options);
     if (b.equal_lacunas) {
-      options.last_lacuna_scale.assign(spec.cells.size(), options.lacuna_scale);
-      for (int lower = 0; lower <= b.grade_levels; ++lower) {
-        std::vector<double> group;
-        for (size_t c = 0; c < spec.cells.size(); ++c)
-          if (lowered[c] == lower) group.push_back(lacuna_sizes[c]);
-        const std::vector<double> scales = bcifs::lacuna_scales_for_sizes(group, options.lacuna_scale);
-        for (size_t c = 0, k = 0; c < spec.cells.size(); ++c)
-          if (lowered[c] == lower) options.last_lacuna_scale[c] = scales[k++];
-      }
-      // A lacuna is its cell scaled: the sizes scale with the last lacuna scales.
+      const bcifs::LastLacunas plain = bcifs::last_lacuna_sizes(rules, spec, b.level, options);
+      std::vector<double> target(size_t(b.grade_levels) + 1, HUGE_VAL);
       for (size_t c = 0; c < spec.cells.size(); ++c)
-        lacuna_sizes[c] *= options.last_lacuna_scale[c] / options.lacuna_scale;
+        if (plain.smallest_mm[c] > 0)
+          target[size_t(lowered[c])] = std::min(target[size_t(lowered[c])], plain.smallest_mm[c]);
+      options.last_lacuna_mm.assign(spec.cells.size(), 0.0);
+      for (size_t c = 0; c < spec.cells.size(); ++c)
+        if (std::isfinite(target[size_t(lowered[c])])) options.last_lacuna_mm[c] = target[size_t(lowered[c])];
     }
+    const bcifs::LastLacunas lacunas = bcifs::last_lacuna_sizes(rules, spec, b.level, options);
     BcifsVolumeReport report;
     add_cells(rules, spec, b.level, options, report);
     report.tetrahedra = spec.cells.size();
@@ -768,17 +765,14 @@ class Builder {
     report.max_cell_mm = *std::max_element(sizes.begin(), sizes.end());
     for (const bcifs::CellSpec& c : spec.cells) report.max_delay = std::max(report.max_delay, c.delay);
     report.min_lacuna_mm = HUGE_VAL;
-    for (double l : lacuna_sizes)
-      if (l > 0) {
-        report.min_lacuna_mm = std::min(report.min_lacuna_mm, l);
-        report.max_lacuna_mm = std::max(report.max_lacuna_mm, l);
+    for (size_t c = 0; c < spec.cells.size(); ++c)
+      if (lacunas.largest_mm[c] > 0) {
+        report.min_lacuna_mm = std::min(report.min_lacuna_mm, lacunas.smallest_mm[c]);
+        report.max_lacuna_mm = std::max(report.max_lacuna_mm, lacunas.largest_mm[c]);
       }
     if (!(report.max_lacuna_mm > 0)) report.min_lacuna_mm = 0;
-    report.min_lacuna_scale = report.max_lacuna_scale = options.lacuna_scale;
-    for (double s : options.last_lacuna_scale) {
-      report.min_lacuna_scale = std::min(report.min_lacuna_scale, s);
-      report.max_lacuna_scale = std::max(report.max_lacuna_scale, s);
-    }
+    report.min_lacuna_scale = lacunas.min_scale;
+    report.max_lacuna_scale = lacunas.max_scale;
     report.min_level = b.level - *std::max_element(lowered.begin(), lowered.end());
     report.max_level = b.level - *std::min_element(lowered.begin(), lowered.end());
     out_.report = report;

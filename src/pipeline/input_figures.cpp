@@ -81,8 +81,12 @@ std::vector<InputFigure> input_figures(const BuiltInputs& inputs) {
                          as_string(images.plot_png)});
     }
     if (input.volume) {
-      // Measured to its level while that has at most kMaxMeasuredCells cells (else to the deepest that has).
-      const VolumeCellMeasures measures = measure_volume(input.volume->spec, input.volume->options, input.volume->level);
+      // Drawn at its level, or the deepest below with at most 50 000 cells, so that the pictures cost little
+      // beside the run (the whole run's peak memory is taken before them).
+      const bcifs::VolumeRules rules = bcifs::build_volume_rules(input.volume->spec);
+      int drawn = input.volume->level;
+      while (drawn > 0 && bcifs::volume_cells(rules, drawn) > 50000) --drawn;
+      const VolumeCellMeasures measures = measure_volume(input.volume->spec, input.volume->options, drawn);
       VolumeImages images = volume_images(measures);
       const std::string level = std::to_string(measures.geometry_last);
       for (size_t axis = 0; axis < 3; ++axis) {

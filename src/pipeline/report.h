@@ -97,8 +97,8 @@ struct BcifsVolumeReport {
   size_t tetrahedra = 0;
   double min_cell_mm = 0, max_cell_mm = 0;
   int max_delay = 0;
-  double min_lacuna_mm = 0, max_lacuna_mm = 0;  // per tetrahedron, its last level's lacunas (geometric mean)
-  double min_lacuna_scale = 0, max_lacuna_scale = 0;  // the tetrahedra's last lacuna scales
+  double min_lacuna_mm = 0, max_lacuna_mm = 0;        // the lacunas the last level makes, each one
+  double min_lacuna_scale = 0, max_lacuna_scale = 0;  // their scales
   int min_level = 0, max_level = 0;                   // the levels a grade leaves (both `level` without one)
 };
 

@@ -491,6 +491,9 @@ void add_generators(py::module_& m) {
   m.def(
       "bcifs_volume_measure",
       [](int last, const py::kwargs& keys) {
+        if (last < 0 || last > kMaxTopologyLevel)
+          throw InvalidInput("last: expected a level from 0 to " + std::to_string(kMaxTopologyLevel) + ", got " +
+                             std::to_string(last));
         nlohmann::json object = to_json(keys, "lacuna.bcifs_volume_measure");
         object["type"] = "bcifs_volume";
         const Recipe recipe = parse_recipe(

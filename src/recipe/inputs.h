@@ -225,16 +225,17 @@ struct BcifsVolumeInput {
 
 // "bcifs_infill": another input's hull, inset by a skin, divided into tetrahedra that conform to it (a Kuhn grid of
 // cell_mm, its outside corners moved onto the inset), every tetrahedron a lacunar cell, delayed by its size and
-// its last lacuna scaled so that the lacunas have one size (equal_lacunas).
+// every last lacuna scaled down to the smallest one's size (equal_lacunas).
 struct BcifsInfillInput {
   std::string hull;
   double skin_mm = 1;
   double cell_mm = 10;
   int level = 2;
   bool equal_lacunas = true;
-  // Grading: a field over the hull (depth measured in `hull`) lowers the level where it is below 1: a cell
-  // subdivides level - grade_levels + #{k < grade_levels : field at its centre > (k + 1) / (grade_levels + 1)}
-  // times (as a lattice's level grade), by a larger delay, so faces between levels stay consistent.
+  // Grading: a field over the hull (depth measured in `hull`) lowers the level where it is at most
+  // grade_levels / (grade_levels + 1): a cell is lowered by grade_levels - #{k < grade_levels : field at its centre >
+  // (k + 1) / (grade_levels + 1)} levels (as a lattice's level grade), added to its delay by size and capped at
+  // `level` (every cell subdivides at least once), so faces between levels stay consistent.
   GradeField grade;     // kind kNone: no grading
   int grade_levels = 0;
   bcifs::FaceType face;  // one edge in its boundary: the type of every edge
