@@ -112,7 +112,10 @@ TEST(BcifsVolume, PlainHexahedronIsSixHexahedraAroundALacuna) {
     EXPECT_NEAR(total_volume(level, spec), 1000 * std::pow(1 - s * s * s, k), 1e-9);
     EXPECT_NEAR(pieces_volume(convex_pieces(level, spec)), 1000 * std::pow(1 - s * s * s, k) * kGrown, 1e-9);
   }
-  const VolumeMeasures m = volume_measures(rules, spec, 3, options);
+  VolumeLevel last;
+  const VolumeMeasures m = volume_measures(rules, spec, 3, options, &last);
+  EXPECT_EQ(last.cells.size(), 216u);  // the level it measured last, handed back
+  EXPECT_NEAR(total_volume(last, spec), m.volume[3], 1e-9);
   EXPECT_NEAR(m.volume_factor, 1 - s * s * s, 1e-12);
   EXPECT_NEAR(m.surface[0], 600, 1e-9);
   // Level 1: the cube's faces and the lacuna's (the six hexahedra share their slanted sides).

@@ -126,6 +126,18 @@ size_t count(const std::string& text, const std::string& what) {
   return n;
 }
 
+// Runs dir/r.json with its outputs in dir/out.
+RunReport run_recipe(const test::TempDir& dir) {
+  RunOptions options;
+  options.output_dir = (dir / "out").string();
+  return run((dir / "r.json").string(), options);
+}
+
+// The pictures the page in dir/out carries.
+nlohmann::json page_pictures(const test::TempDir& dir) {
+  return nlohmann::json::parse(script_text(test::read_file(dir / "out" / "report.html"), "lacuna-page-data"))["pictures"];
+}
+
 TEST(ReportPage, InputFiguresOfPlatesAndPatterns) {
   test::TempDir dir;
   // A lacunar hexagon at level 2 and a p4m pattern of circles over 2 x 2 cells.
@@ -136,12 +148,9 @@ TEST(ReportPage, InputFiguresOfPlatesAndPatterns) {
                 "gap_mm": 0.3, "seed": 7, "height_mm": 2,
                 "wallpaper": {"group": "p4m", "a_mm": [20, 0], "b_mm": [0, 20], "cells": [2, 2], "policy": "snap"}}},
     "outputs": [{"of": "plate", "file": "plate.stl"}, {"of": "holes", "file": "holes.stl"}]})");
-  RunOptions options;
-  options.output_dir = (dir / "out").string();
-  const RunReport report = run((dir / "r.json").string(), options);
+  const RunReport report = run_recipe(dir);
   ASSERT_TRUE(report.valid);
-  const std::string html = test::read_file(dir / "out" / "report.html");
-  const nlohmann::json pictures = nlohmann::json::parse(script_text(html, "lacuna-page-data"))["pictures"];
+  const nlohmann::json pictures = page_pictures(dir);
   ASSERT_EQ(pictures.size(), 3u);
   // In the order of the recipe's inputs (read as a JSON object: by name).
   // The pattern over 3 x 3 cells: every cell holds the images the 2 x 2 cells of the solid hold a
@@ -166,12 +175,9 @@ TEST(ReportPage, InputFiguresOfVolumes) {
     "inputs": {"v": {"type": "bcifs_volume", "cell": "hexahedron", "edge_mm": 8, "edge": "B2", "params": "B2 B2 B2",
                      "level": 1, "center_mm": [0, 0, 4]}},
     "outputs": [{"of": "v", "file": "v.stl"}]})");
-  RunOptions options;
-  options.output_dir = (dir / "out").string();
-  const RunReport report = run((dir / "r.json").string(), options);
+  const RunReport report = run_recipe(dir);
   ASSERT_TRUE(report.valid);
-  const std::string html = test::read_file(dir / "out" / "report.html");
-  const nlohmann::json pictures = nlohmann::json::parse(script_text(html, "lacuna-page-data"))["pictures"];
+  const nlohmann::json pictures = page_pictures(dir);
   ASSERT_EQ(pictures.size(), 4u);
   EXPECT_EQ(pictures[0]["caption"], "v: density of the section x = 0 mm at level 1 (windows of 31 of 1024 pixels)");
   EXPECT_EQ(pictures[2]["caption"], "v: density of the section z = 4 mm at level 1 (windows of 31 of 1024 pixels)");

@@ -833,7 +833,7 @@ LastLacunas last_lacuna_sizes(const VolumeRules& rules, const VolumeSpec& spec, 
 }
 
 VolumeMeasures volume_measures(const VolumeRules& rules, const VolumeSpec& spec, int levels,
-                               const VolumeGeometryOptions& options) {
+                               const VolumeGeometryOptions& options, VolumeLevel* last) {
   validate(options);
   if (levels < 0) throw InvalidInput("volume_measures: levels must be >= 0, got " + std::to_string(levels));
   check_cell_count(rules, levels);
@@ -851,7 +851,10 @@ VolumeMeasures volume_measures(const VolumeRules& rules, const VolumeSpec& spec,
       if (level.owners[f] == 1) a += norm(newell(level.faces[f].polygon)) / 2;
     m.volume.push_back(v);
     m.surface.push_back(a);
-    if (i == levels) break;
+    if (i == levels) {
+      if (last) *last = std::move(level);
+      break;
+    }
     // What the next subdivision opens and empties. A delayed cell's faces are delayed too, so a face of delay 1
     // belongs to cells that all subdivide now.
     opened = 0;

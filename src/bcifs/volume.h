@@ -265,8 +265,9 @@ struct VolumeMeasures {
   std::vector<double> genus;
 };
 
+// `last`, when given, receives the realized level `levels` (what realize_volume would return).
 VolumeMeasures volume_measures(const VolumeRules& rules, const VolumeSpec& spec, int levels,
-                               const VolumeGeometryOptions& options = {});
+                               const VolumeGeometryOptions& options = {}, VolumeLevel* last = nullptr);
 
 }  // namespace bcifs
 }  // namespace lacuna

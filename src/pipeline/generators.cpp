@@ -272,9 +272,9 @@ VolumeCellMeasures measure_volume(const bcifs::VolumeSpec& spec, const bcifs::Vo
   m.face_type_count = rules.faces.rules.size();
   while (m.geometry_last < last && bcifs::volume_cells(rules, m.geometry_last + 1) <= kMaxMeasuredCells)
     ++m.geometry_last;
-  m.geometry = bcifs::volume_measures(rules, spec, m.geometry_last, options);
-  const std::vector<ConvexCells> pieces =
-      bcifs::convex_pieces(bcifs::realize_volume(rules, spec, m.geometry_last, options), spec);
+  bcifs::VolumeLevel deepest;
+  m.geometry = bcifs::volume_measures(rules, spec, m.geometry_last, options, &deepest);
+  const std::vector<ConvexCells> pieces = bcifs::convex_pieces(deepest, spec);
   const bcifs::VoxelGrid grid = bcifs::voxel_grid(pieces, kVolumeBoxGrid);
   const size_t n = size_t(grid.size);
   std::vector<uint8_t> mask(n * n * n);

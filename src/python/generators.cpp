@@ -168,6 +168,30 @@ py::dict walls_dict(const voronoi::Walls& w) {
   return d;
 }
 
+// One recipe input of `type` from keyword arguments, checked as a recipe would check it (messages name `where`).
+template <typename Input>
+Input one_input(const py::kwargs& keys, const char* type, const char* name, const char* where) {
+  nlohmann::json object = to_json(keys, where);
+  object["type"] = type;
+  const Recipe recipe = parse_recipe(
+      nlohmann::json{{"inputs", {{name, object}}}, {"outputs", {{{"of", name}, {"file", std::string(name) + ".stl"}}}}}
+          .dump(),
+      where);
+  return std::get<Input>(recipe.inputs.front().spec);
+}
+
+// A face or cell type's counts: N^C_i under `count_key`, N^L_i, R_i, R and the spectral radius.
+py::dict lacunarity_dict(const bcifs::Lacunarity& l, int type, const char* count_key) {
+  py::dict e;
+  e["type"] = type;
+  e[count_key] = numbers_array(l.subfaces);
+  e["lacunas"] = numbers_array(l.lacunas);
+  e["ratio"] = numbers_array(l.ratio);
+  e["r_limit"] = l.limit;
+  e["spectral_radius"] = l.spectral_radius;
+  return e;
+}
+
 }  // namespace
 
 void add_generators(py::module_& m) {
@@ -441,29 +465,14 @@ void add_generators(py::module_& m) {
       "bcifs_measure",
       [](const py::object& levels, const py::kwargs& keys) {
         const std::pair<int, int> range = levels.cast<std::pair<int, int>>();
-        nlohmann::json object = to_json(keys, "lacuna.bcifs_measure");
-        object["type"] = "bcifs_plate";
-        const Recipe recipe = parse_recipe(
-            nlohmann::json{{"inputs", {{"plate", object}}}, {"outputs", {{{"of", "plate"}, {"file", "plate.stl"}}}}}
-                .dump(),
-            "lacuna.bcifs_measure");
-        const BcifsPlateInput input = std::get<BcifsPlateInput>(recipe.inputs.front().spec);
+        const BcifsPlateInput input = one_input<BcifsPlateInput>(keys, "bcifs_plate", "plate", "lacuna.bcifs_measure");
         const PlateMeasures measures = released([&] {
           const bcifs::Plate plate = build_plate(input, "lacuna.bcifs_measure", "inputs.plate");
           return measure_plate(plate, range.first, range.second);
         });
         py::list faces;
-        for (size_t f = 0; f < measures.faces.size(); ++f) {
-          const bcifs::Lacunarity& l = measures.faces[f];
-          py::dict e;
-          e["type"] = measures.face_types[f];
-          e["subfaces"] = numbers_array(l.subfaces);
-          e["lacunas"] = numbers_array(l.lacunas);
-          e["ratio"] = numbers_array(l.ratio);
-          e["r_limit"] = l.limit;
-          e["spectral_radius"] = l.spectral_radius;
-          faces.append(e);
-        }
+        for (size_t f = 0; f < measures.faces.size(); ++f)
+          faces.append(lacunarity_dict(measures.faces[f], measures.face_types[f], "subfaces"));
         py::dict boxes;
         boxes["region_dimension"] = measures.region.dimension;
         boxes["boundary_dimension"] = measures.boundary.dimension;
@@ -494,25 +503,11 @@ void add_generators(py::module_& m) {
         if (last < 0 || last > kMaxTopologyLevel)
           throw InvalidInput("last: expected a level from 0 to " + std::to_string(kMaxTopologyLevel) + ", got " +
                              std::to_string(last));
-        nlohmann::json object = to_json(keys, "lacuna.bcifs_volume_measure");
-        object["type"] = "bcifs_volume";
-        const Recipe recipe = parse_recipe(
-            nlohmann::json{{"inputs", {{"volume", object}}}, {"outputs", {{{"of", "volume"}, {"file", "volume.stl"}}}}}
-                .dump(),
-            "lacuna.bcifs_volume_measure");
-        const BcifsVolumeInput input = std::get<BcifsVolumeInput>(recipe.inputs.front().spec);
+        const BcifsVolumeInput input =
+            one_input<BcifsVolumeInput>(keys, "bcifs_volume", "volume", "lacuna.bcifs_volume_measure");
         const VolumeCellMeasures vm = released([&] { return measure_volume(input.spec, input.options, last); });
         py::list cells;
-        for (size_t c = 0; c < vm.cells.size(); ++c) {
-          const bcifs::Lacunarity& l = vm.cells[c];
-          py::dict e;
-          e["type"] = vm.cell_types[c];
-          e["cells"] = numbers_array(l.subfaces);
-          e["lacunas"] = numbers_array(l.lacunas);
-          e["ratio"] = numbers_array(l.ratio);
-          e["r_limit"] = l.limit;
-          cells.append(e);
-        }
+        for (size_t c = 0; c < vm.cells.size(); ++c) cells.append(lacunarity_dict(vm.cells[c], vm.cell_types[c], "cells"));
         py::dict boxes;
         boxes["grid"] = kVolumeBoxGrid;
         boxes["fill"] = vm.grid_fill;
