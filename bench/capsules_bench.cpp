@@ -140,7 +140,8 @@ int run_bench(int argc, char** argv) {
   double radius = 0.5, step = 0.5, box = 0;
   bool soup = false, full = false, only_recipe = false;
   double recipe_simplify_mm = -1, reference_voxel_mm = 0;
-  double simplify_mm = 0;
+  double simplify_mm = 0, merge_fraction = -1;
+  bool skip_plain = false;
   bool hausdorff = false;
   int threads = 0;
   std::string out_dir = "capsules-bench-out";
@@ -153,6 +154,8 @@ int run_bench(int argc, char** argv) {
   app.add_option("--threads", threads, "Worker threads (default all)");
   app.add_flag("--hausdorff", hausdorff, "With --simplify: the sampled one-sided Hausdorff distances both ways");
   app.add_option("--simplify", simplify_mm, "Also time extraction with simplification to this deviation (mm), and its check");
+  app.add_option("--merge-fraction", merge_fraction, "With --simplify: the share of the deviation the cubes' merge may use (default: the library's)");
+  app.add_flag("--skip-plain", skip_plain, "With --simplify and without --hausdorff: do not extract the plain surface first");
   app.add_option("--out", out_dir, "Folder for the recipe run's output");
   app.add_flag("--only-recipe", only_recipe, "With --full: skip the direct rasterization, so the peak memory is the recipe's");
   app.add_option("--recipe-simplify", recipe_simplify_mm, "With --full: the recipe's simplify_mm (default: the recipe default)");
@@ -191,19 +194,22 @@ int run_bench(int argc, char** argv) {
   }
   if (simplify_mm > 0) {
     auto t3 = std::chrono::steady_clock::now();
-    TriMesh plain = extract_surface(direct);
+    TriMesh plain = skip_plain && !hausdorff ? TriMesh() : extract_surface(direct);
     result["extract_seconds"] = seconds_since(t3);
     result["extract_triangles"] = plain.triangles.size();
-    result["extract_volume_mm3"] = check_mesh(plain).volume_mm3;
+    if (!plain.triangles.empty()) result["extract_volume_mm3"] = check_mesh(plain).volume_mm3;
     if (!hausdorff) plain = TriMesh();
     SimplifyOptions so;
     so.max_deviation_mm = simplify_mm;
+    if (merge_fraction >= 0) so.merge_fraction = merge_fraction;
     SimplifyStats stats;
     auto t4 = std::chrono::steady_clock::now();
     TriMesh compact = extract_simplified_surface(direct, so, &stats);
     result["extract_simplified_seconds"] = seconds_since(t4);
     result["simplified_triangles"] = compact.triangles.size();
     result["simplify_regions"] = stats.regions;
+    result["simplify_input_triangles"] = stats.input_triangles;
+    result["simplify_merged_triangles"] = stats.merged_triangles;
     result["simplify_regions_redone"] = stats.regions_redone;
     auto t5 = std::chrono::steady_clock::now();
     MeshCheckReport check = check_mesh(compact);

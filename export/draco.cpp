@@ -114,11 +114,12 @@ int draco_quantization_bits(const TriMesh& mesh, double max_move_mm) {
   return 0;
 }
 
-std::string encode_draco(const TriMesh& mesh, int bits) {
+std::string encode_draco(const TriMesh& mesh, int bits, int speed) {
   if (mesh.positions_mm.size() > uint64_t(std::numeric_limits<int32_t>::max()) ||
       mesh.triangles.size() > uint64_t(std::numeric_limits<int32_t>::max()) / 3)
     throw ResourceLimit("a Draco file holds at most 2^31 vertices and 715 827 882 triangles");
   if (bits < 1 || bits > kMaxDracoBits) throw InvalidInput("Draco quantization needs 1 to 30 bits");
+  if (speed < 0 || speed > 10) throw InvalidInput("Draco's speed runs from 0 to 10");
   draco::Mesh out;
   const auto points = uint32_t(mesh.positions_mm.size());
   out.set_num_points(points);
@@ -141,7 +142,7 @@ std::string encode_draco(const TriMesh& mesh, int bits) {
   draco::Encoder encoder;
   encoder.SetAttributeQuantization(draco::GeometryAttribute::POSITION, bits);
   encoder.SetEncodingMethod(draco::MESH_EDGEBREAKER_ENCODING);
-  encoder.SetSpeedOptions(0, 0);
+  encoder.SetSpeedOptions(speed, speed);
   draco::EncoderBuffer buffer;
   const draco::Status status = encoder.EncodeMeshToBuffer(out, &buffer);
   if (!status.ok()) throw InternalError(std::string("Draco could not encode the mesh: ") + status.error_msg());

@@ -20,9 +20,10 @@ double draco_move_bound_mm(const TriMesh& mesh, int bits);
 constexpr int kMaxDracoBits = 30;
 int draco_quantization_bits(const TriMesh& mesh, double max_move_mm);
 
-// The mesh as a Draco file (positions only, one point per vertex, edgebreaker at the best
-// compression). Byte-identical output for identical input. Throws ResourceLimit past 2^31 vertices.
-std::string encode_draco(const TriMesh& mesh, int bits);
+// The mesh as a Draco file (positions only, one point per vertex, edgebreaker; `speed` is Draco's
+// encoding and decoding speed, 0 the best compression and 10 the fastest). Byte-identical output
+// for identical input. Throws ResourceLimit past 2^31 vertices.
+std::string encode_draco(const TriMesh& mesh, int bits, int speed = 0);
 
 // A Draco file's triangle mesh; `label` names it in messages (InvalidInput when it is not a Draco
 // triangle mesh or is malformed, ResourceLimit when its declared counts exceed the budget).

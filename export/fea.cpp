@@ -100,7 +100,7 @@ void write_msh(const std::string& path, const TetMesh& m, bool version_2) {
   w.close();
 }
 
-void write_inp(const std::string& path, const TetMesh& m, bool quadratic) {
+void write_inp(const std::string& path, const TetMesh& m, bool quadratic, double node_set_tolerance_mm) {
   Writer w(path);
   MidNodes mids;
   if (quadratic) mids = mid_nodes(m);
@@ -138,7 +138,7 @@ void write_inp(const std::string& path, const TetMesh& m, bool quadratic) {
   // Nodes on the bounding box's planes, corner and mid-side alike, for boundary conditions.
   Box3 box;
   for (const Vec3d& p : m.nodes_mm) box.expand(p);
-  const double tolerance = 1e-6 * std::max(norm(box.size()), 1e-300);
+  const double tolerance = std::max(1e-6 * std::max(norm(box.size()), 1e-300), node_set_tolerance_mm);
   const char* names[3][2] = {{"NXMIN", "NXMAX"}, {"NYMIN", "NYMAX"}, {"NZMIN", "NZMAX"}};
   const size_t total = m.nodes_mm.size() + mids.positions.size();
   auto node = [&](size_t i) { return i < m.nodes_mm.size() ? m.nodes_mm[i] : mids.positions[i - m.nodes_mm.size()]; };
@@ -208,7 +208,7 @@ FeaFormat fea_format_from_path(const std::string& path) {
 void write_fea(const std::string& path, FeaFormat format, const TetMesh& mesh, const FeaWriteOptions& options) {
   switch (format) {
     case FeaFormat::kMsh: return write_msh(path, mesh, options.msh_version_2);
-    case FeaFormat::kInp: return write_inp(path, mesh, options.quadratic);
+    case FeaFormat::kInp: return write_inp(path, mesh, options.quadratic, options.node_set_tolerance_mm);
     case FeaFormat::kVtu: return write_vtu(path, mesh);
     case FeaFormat::kMedit: return write_medit(path, mesh);
   }

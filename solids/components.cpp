@@ -39,50 +39,48 @@ std::vector<MeshComponent> mesh_components(const TriMesh& m) {
   return out;
 }
 
-namespace {
-
-// Removes the components `drop_it` picks and the vertices left unused; returns how many.
-template <class Pick>
-size_t drop_components(TriMesh& mesh, Pick&& drop_it) {
-  std::vector<char> drop(mesh.triangles.size(), 0);
-  size_t removed = 0;
-  for (const MeshComponent& c : mesh_components(mesh)) {
-    if (!drop_it(c)) continue;
-    ++removed;
-    for (uint32_t f : c.triangles) drop[f] = 1;
+SmallShells remove_small_shells(TriMesh& mesh, double max_volume_mm3) {
+  SmallShells removed;
+  const VertexComponents components = vertex_components(mesh);
+  const size_t nc = components.count;
+  // Six times each shell's volume, from a point of its own (its first vertex) to keep the digits.
+  std::vector<double> volume6(nc, 0.0);
+  std::vector<uint32_t> anchor(nc, UINT32_MAX);
+  for (const auto& t : mesh.triangles) {
+    const uint32_t c = components.of_vertex[t[0]];
+    if (anchor[c] == UINT32_MAX) anchor[c] = t[0];
+    const Vec3d& o = mesh.positions_mm[anchor[c]];
+    volume6[c] += dot(mesh.positions_mm[t[0]] - o, cross(mesh.positions_mm[t[1]] - o, mesh.positions_mm[t[2]] - o));
   }
-  if (removed == 0) return 0;
-  std::vector<int64_t> index(mesh.positions_mm.size(), -1);
-  TriMesh kept;
-  for (size_t f = 0; f < mesh.triangles.size(); ++f) {
-    if (drop[f]) continue;
-    std::array<uint32_t, 3> t{};
-    for (int k = 0; k < 3; ++k) {
-      const uint32_t v = mesh.triangles[f][size_t(k)];
-      if (index[v] < 0) {
-        index[v] = int64_t(kept.positions_mm.size());
-        kept.positions_mm.push_back(mesh.positions_mm[v]);
-      }
-      t[size_t(k)] = uint32_t(index[v]);
+  std::vector<uint8_t> drop(nc, 0);
+  for (size_t c = 0; c < nc; ++c) {
+    const double v = volume6[c] / 6;
+    if (v < 0 && -v < max_volume_mm3) {
+      drop[c] = 1;
+      ++removed.cavities;
+    } else if (v >= 0 && v < max_volume_mm3) {
+      drop[c] = 1;
+      ++removed.specks;
     }
-    kept.triangles.push_back(t);
+  }
+  if (removed.cavities + removed.specks == 0) return removed;
+  std::vector<uint32_t> index(mesh.positions_mm.size(), UINT32_MAX);
+  TriMesh kept;
+  for (const auto& t : mesh.triangles) {
+    if (drop[components.of_vertex[t[0]]]) continue;
+    std::array<uint32_t, 3> out{};
+    for (int k = 0; k < 3; ++k) {
+      uint32_t& i = index[t[size_t(k)]];
+      if (i == UINT32_MAX) {
+        i = uint32_t(kept.positions_mm.size());
+        kept.positions_mm.push_back(mesh.positions_mm[t[size_t(k)]]);
+      }
+      out[size_t(k)] = i;
+    }
+    kept.triangles.push_back(out);
   }
   mesh = std::move(kept);
   return removed;
-}
-
-}  // namespace
-
-size_t fill_small_cavities(TriMesh& mesh, double max_volume_mm3) {
-  return drop_components(mesh, [&](const MeshComponent& c) {
-    return c.signed_volume_mm3 < 0 && -c.signed_volume_mm3 < max_volume_mm3;
-  });
-}
-
-size_t remove_small_specks(TriMesh& mesh, double max_volume_mm3) {
-  return drop_components(mesh, [&](const MeshComponent& c) {
-    return c.signed_volume_mm3 >= 0 && c.signed_volume_mm3 < max_volume_mm3;
-  });
 }
 
 }  // namespace lacuna

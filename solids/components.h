@@ -19,15 +19,17 @@ struct MeshComponent {
 // The components in order of their first triangle.
 std::vector<MeshComponent> mesh_components(const TriMesh& mesh);
 
-// Removes the cavity shells (components of negative volume) enclosing less than `max_volume_mm3`,
-// which fills those pockets, and the vertices left unused; returns how many were removed. A
-// level set meshed at voxel size h cannot resolve a pocket below h^3: where three tubes meet,
-// marching tetrahedra can close one off from sub-voxel sign changes.
-size_t fill_small_cavities(TriMesh& mesh, double max_volume_mm3);
+// What remove_small_shells removed.
+struct SmallShells {
+  size_t cavities = 0;  // cavity shells (negative volume), so their pockets are filled
+  size_t specks = 0;    // outward shells
+};
 
-// Removes the specks: outward shells (components of non-negative volume) enclosing less than
-// `max_volume_mm3`. Below h^3 they are what is left of sub-voxel features (a sliver a drain hole
-// cut off, a wall's corner clipped by a hull): unprintable dust, not part of the design.
-size_t remove_small_specks(TriMesh& mesh, double max_volume_mm3);
+// Removes the shells enclosing less than `max_volume_mm3` and the vertices left unused. A level
+// set meshed at voxel size h resolves nothing below h^3: a cavity shell that small is a pocket
+// marching tetrahedra closed off from sub-voxel sign changes (where three tubes meet); an outward
+// shell that small is what is left of a sub-voxel feature (a sliver a drain hole cut off, a
+// wall's corner clipped by a hull): unprintable dust, not part of the design.
+SmallShells remove_small_shells(TriMesh& mesh, double max_volume_mm3);
 
 }  // namespace lacuna

@@ -3,7 +3,9 @@
 // construction (see README, "Why marching tetrahedra").
 #pragma once
 
+#include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "geometry.h"
 #include "solids/volume.h"
@@ -14,6 +16,11 @@ struct ExtractOptions {
   // Crossing points are kept at least this fraction of an edge away from grid points, so no
   // triangle degenerates and neighbouring cells keep a margin after float32 rounding.
   double min_edge_fraction = 0.01;
+  // BlockExtractor only: when positive, each cube's pieces are merged into fewer triangles on the
+  // same boundary, leaving out the crossings on its body diagonal and on the face diagonals both
+  // cubes of a face agree to leave out, wherever every test passes within this deviation (mm) of
+  // the pieces (see solids/cube_surface.h); 0 keeps the marching-tetrahedra pieces.
+  double merge_deviation_mm = 0;
 };
 
 // Triangulates the zero level set of the volume. Vertices are in mm, triangles counter-clockwise
@@ -31,6 +38,10 @@ struct SurfaceBlock {
   std::vector<Vec3d> positions_mm;        // float32 values
   std::vector<uint64_t> keys;             // kInteriorVertex, or the grid edge of a vertex on the boundary
   std::vector<std::array<uint32_t, 3>> triangles;
+  uint64_t piece_triangles = 0;           // the marching-tetrahedra triangles of the block (before merging)
+  // Per vertex: six times the volume the merge lost near it (its share of its patches' losses;
+  // all zero unmerged). The shares of all blocks sum to six times the whole surface's loss.
+  std::vector<double> volume_debt6;
 };
 constexpr uint64_t kInteriorVertex = UINT64_MAX;
 
@@ -51,5 +62,19 @@ class BlockExtractor {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// Global vertex numbers for blocks extracted one by one (keys[b] the keys of block b's vertices):
+// the blocks' interior vertices in block order, then the vertices on block faces once per grid
+// edge, in key order. Fills global[b][v] and returns the number of vertices. Throws
+// std::length_error past 4 billion vertices.
+uint64_t number_block_vertices(const std::vector<const std::vector<uint64_t>*>& keys,
+                               std::vector<std::vector<uint32_t>>& global);
+
+// The surface cut into blocks of `block_voxels`, each extracted with `options` (so merged when
+// options.merge_deviation_mm > 0), and welded into one mesh. The same guarantees as
+// extract_surface. `volume_debt6`, when given, receives the blocks' SurfaceBlock::volume_debt6
+// per vertex of the mesh (summed where blocks share a vertex).
+TriMesh extract_block_surface(const Volume& volume, const ExtractOptions& options, int block_voxels = 32,
+                              std::vector<double>* volume_debt6 = nullptr);
 
 }  // namespace lacuna

@@ -9,27 +9,6 @@
 #include "solids/disjoint_sets.h"
 
 namespace lacuna {
-namespace {
-
-// Buckets keyed by vertex, filled in increasing order of the item: offsets[v] .. offsets[v + 1].
-template <class KeyOf, class ItemOf, class Item>
-void bucket_by_vertex(size_t nv, size_t items, KeyOf&& key_of, ItemOf&& item_of, std::vector<uint64_t>& offsets,
-                      std::vector<Item>& out) {
-  offsets.assign(nv + 1, 0);
-  for (size_t i = 0; i < items; ++i) {
-    const uint32_t v = key_of(i);
-    if (v != UINT32_MAX) ++offsets[v + 1];
-  }
-  for (size_t v = 0; v < nv; ++v) offsets[v + 1] += offsets[v];
-  out.resize(offsets[nv]);
-  std::vector<uint64_t> cursor(offsets.begin(), offsets.end() - 1);
-  for (size_t i = 0; i < items; ++i) {
-    const uint32_t v = key_of(i);
-    if (v != UINT32_MAX) out[cursor[v]++] = item_of(i);
-  }
-}
-
-}  // namespace
 
 EdgeTopology edge_topology(const TriMesh& mesh, bool with_partners) {
   return edge_topology(mesh, vertex_corners(mesh), with_partners);
@@ -111,10 +90,28 @@ EdgeTopology edge_topology(const TriMesh& mesh, const VertexCorners& corners, bo
 }
 
 VertexCorners vertex_corners(const TriMesh& mesh) {
+  // A counting sort in parallel: counts and places by atomic increments, then each vertex's few
+  // corners sorted (so the result is the same for any number of threads).
   VertexCorners r;
-  bucket_by_vertex(
-      mesh.positions_mm.size(), 3 * mesh.triangles.size(), [&](size_t c) { return mesh.triangles[c / 3][c % 3]; },
-      [](size_t c) { return uint32_t(c); }, r.offsets, r.corners);
+  const size_t nv = mesh.positions_mm.size(), nc = 3 * mesh.triangles.size();
+  std::vector<uint32_t> count(nv + 1, 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nc, 16384), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t c = range.begin(); c != range.end(); ++c)
+      __atomic_fetch_add(&count[mesh.triangles[c / 3][c % 3] + 1], 1u, __ATOMIC_RELAXED);
+  });
+  r.offsets.resize(nv + 1);
+  r.offsets[0] = 0;
+  for (size_t v = 0; v < nv; ++v) r.offsets[v + 1] = r.offsets[v] + count[v + 1];
+  r.corners.resize(nc);
+  std::vector<uint64_t> cursor(r.offsets.begin(), r.offsets.end() - 1);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nc, 16384), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t c = range.begin(); c != range.end(); ++c)
+      r.corners[__atomic_fetch_add(&cursor[mesh.triangles[c / 3][c % 3]], uint64_t{1}, __ATOMIC_RELAXED)] = uint32_t(c);
+  });
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 8192), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t v = range.begin(); v != range.end(); ++v)
+      std::sort(r.corners.begin() + int64_t(r.offsets[v]), r.corners.begin() + int64_t(r.offsets[v + 1]));
+  });
   return r;
 }
 

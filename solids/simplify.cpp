@@ -22,14 +22,17 @@ namespace {
 constexpr uint32_t kNone = UINT32_MAX;
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeviationMargin = 0.75;
+  // how near the block faces the pass across them looks
 // A triangle's shape: 4 sqrt(3) area over the sum of its squared edges, 1 when equilateral, 0 when
 // flat; collapses may not push the worst triangle they touch below this (see RegionSimplifier::collapse).
 constexpr double kMinQuality = 0.15;
 
-double quality(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+// The square of that shape measure (no square root needed to compare it).
+double quality2(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
   const Vec3d ab = b - a, bc = c - b, ca = a - c;
   const double edges = dot(ab, ab) + dot(bc, bc) + dot(ca, ca);
-  return edges > 0 ? 2 * std::sqrt(3.0) * norm(cross(ab, -ca)) / edges : 0;
+  const Vec3d n = cross(ab, -ca);
+  return edges > 0 ? 12 * dot(n, n) / (edges * edges) : 0;
 }
 
 
@@ -55,6 +58,12 @@ struct Quadric {
     a00 += o.a00, a01 += o.a01, a02 += o.a02, a11 += o.a11, a12 += o.a12, a22 += o.a22;
     b0 += o.b0, b1 += o.b1, b2 += o.b2, c += o.c, w += o.w;
     return *this;
+  }
+  // Whether the planes are all one plane (their unit normals agree to about 0.1 degrees): the
+  // squared norm of A equals the square of its trace only when A has rank one.
+  bool flat() const {
+    const double frobenius2 = a00 * a00 + a11 * a11 + a22 * a22 + 2 * (a01 * a01 + a02 * a02 + a12 * a12);
+    return w > 0 && frobenius2 >= (1 - 1e-6) * w * w;
   }
   // Mean squared distance (mm^2) of p to the planes.
   double error(const Vec3d& p) const {
@@ -178,13 +187,26 @@ class CollapseQueue {
 };
 
 // What one block of the first pass leaves: its vertices (local numbering), the grid-edge key of
-// those on the block's faces, the quadrics of the vertices that moved freely, and its triangles.
+// those on the block's faces, the quadrics of the vertices that moved freely, the volume still
+// owed near each vertex, and its triangles.
 struct BlockResult {
   std::vector<Vec3d> positions;
   std::vector<uint64_t> keys;
   std::vector<Quadric> quadrics;
   std::vector<uint8_t> has_quadric;
+  std::vector<double> debt6;
   std::vector<std::array<uint32_t, 3>> triangles;
+};
+
+// The vertices of a global mesh between passes. debt6: six times the volume the surface owes
+// near the vertex (what the cubes' merge lost there and no collapse has given back yet); each
+// collapse that may places its vertex to pay its two ends' debts.
+struct Vertices {
+  std::vector<Vec3d> positions;
+  std::vector<Quadric> quadrics;
+  std::vector<uint8_t> has_quadric;
+  std::vector<double> debt6;
+  explicit Vertices(size_t n) : positions(n), quadrics(n), has_quadric(n, 0), debt6(n, 0.0) {}
 };
 
 // One region's piece of the mesh and the collapses in it. Everything is local: vertices and
@@ -212,8 +234,7 @@ class RegionSimplifier {
   // Loads the given triangles of a global mesh; quadrics of vertices that carry one are taken,
   // the others summed from their local triangles.
   void load_global(const RegionBox& box, const std::vector<std::array<uint32_t, 3>>& global_tris,
-                   const std::vector<uint32_t>& tri_ids, const std::vector<Vec3d>& positions,
-                   const std::vector<Quadric>& carried, const std::vector<uint8_t>& has_quadric) {
+                   const std::vector<uint32_t>& tri_ids, const Vertices& vertices) {
     box_ = box;
     const size_t nt = tri_ids.size();
     global_vertex_.clear();
@@ -231,14 +252,17 @@ class RegionSimplifier {
     pos_.resize(nv);
     quadric_.assign(nv, Quadric());
     own_quadric_.assign(nv, 0);
+    debt_.resize(nv);
     for (size_t v = 0; v < nv; ++v) {
       const uint32_t g = global_vertex_[v];
-      pos_[v] = positions[g];
-      if (has_quadric[g]) {  // moved in the first pass: its quadric carries the planes merged into it
-        quadric_[v] = carried[g];
+      pos_[v] = vertices.positions[g];
+      debt_[v] = vertices.debt6[g];
+      if (vertices.has_quadric[g]) {  // moved in the first pass: its quadric carries the planes merged into it
+        quadric_[v] = vertices.quadrics[g];
         own_quadric_[v] = 1;
       }
     }
+    debt_start_ = debt_;
     init();
   }
 
@@ -250,6 +274,9 @@ class RegionSimplifier {
     pos_ = block.positions_mm;
     quadric_.assign(pos_.size(), Quadric());
     own_quadric_.assign(pos_.size(), 0);
+    debt_ = block.volume_debt6;
+    debt_.resize(pos_.size(), 0.0);
+    debt_start_ = debt_;
     init();
   }
 
@@ -273,56 +300,110 @@ class RegionSimplifier {
     }
   }
 
-  // Whether no two live triangles meet other than in the vertices or edge they share: every
-  // pair whose boxes overlap is tested exactly, except pairs sharing a vertex whose fan is a
-  // graph over a coordinate plane.
+  // Whether no two live triangles meet other than in the vertices or edge they share, given that
+  // the loaded triangles did not (the block of a valid surface, or a region of one): every pair
+  // with a changed triangle whose boxes overlap is tested exactly, except pairs sharing a vertex
+  // whose fan is a graph over a coordinate plane (worked out again here, not taken from the
+  // collapses). The boxes go into a grid of fixed cells, filled by counting.
   bool verify() {
-    const size_t nv = pos_.size();
-    graph_axis_.assign(nv, kUnknownAxis);
-    for (uint32_t v = 0; v < nv; ++v) {
-      if (!vertex_alive_[v] || corner_[v] == kNone) continue;
-      fan_scratch_.clear();
-      if (walk_fan(v, nullptr, &fan_scratch_))
-        graph_axis_[v] = graph_state(pos_[v], fan_scratch_, [](uint32_t x) { return x; },
-                                     [&](uint32_t x) { return pos_[x]; });
-    }
-    build_grid();
-    for (uint32_t t = 0; t < tri_.size(); ++t) {
-      if (!tri_alive_[t]) continue;
-      const auto& ids = tri_[t];
-      const std::array<Vec3d, 3> tp{pos_[ids[0]], pos_[ids[1]], pos_[ids[2]]};
-      const Box3 tb = tri_box(tp);
-      next_stamp();
-      bool hit = false;
-      for_cells(tb, [&](size_t cell) {
-        if (hit) return;
-        for (const Entry& en : grid_[cell]) {
-          const uint32_t u = en.tri;
-          if (u <= t || stamp_[u] == stamp_now_ || !overlaps(en, tb)) continue;
-          stamp_[u] = stamp_now_;
-          const auto& uids = tri_[u];
-          if (shares_graph_vertex(ids, uids)) continue;
-          if (exact::faces_intersect(tp, ids, {pos_[uids[0]], pos_[uids[1]], pos_[uids[2]]}, uids)) {
-            hit = true;
-            return;
+    const size_t nt = tri_.size();
+    size_t live = 0;
+    for (uint8_t alive : tri_alive_) live += alive;
+    const int cells = int(std::clamp(std::sqrt(double(live) / 2.0), 4.0, double(kMaxCells)));
+    const Vec3d size = box_.hi - box_.lo;
+    double inv[3];
+    for (int k = 0; k < 3; ++k) inv[k] = cells / size[k];
+    auto coord = [&](double v, int k) { return int(std::clamp(std::floor((v - box_.lo[k]) * inv[k]), 0.0, double(cells - 1))); };
+    verify_boxes_.resize(nt);
+    verify_start_.assign(size_t(cells) * cells * cells + 1, 0);
+    // Calls f(cell index) for every grid cell an entry's box reaches.
+    auto for_cells = [&](const Entry& e, auto&& f) {
+      int lo[3], hi[3];
+      for (int k = 0; k < 3; ++k) {
+        lo[k] = coord(e.lo[k], k);
+        hi[k] = coord(e.hi[k], k);
+      }
+      for (int x = lo[0]; x <= hi[0]; ++x)
+        for (int y = lo[1]; y <= hi[1]; ++y)
+          for (int z = lo[2]; z <= hi[2]; ++z) f(size_t((x * cells + y) * cells + z));
+    };
+    for (int pass = 0; pass < 2; ++pass) {
+      for (uint32_t t = 0; t < nt; ++t) {
+        if (!tri_alive_[t]) continue;
+        if (pass == 0) {
+          const auto& v = tri_[t];
+          const Box3 b = tri_box({pos_[v[0]], pos_[v[1]], pos_[v[2]]});
+          for (int k = 0; k < 3; ++k) {
+            verify_boxes_[t].lo[k] = std::nextafter(float(b.min[k]), -HUGE_VALF);
+            verify_boxes_[t].hi[k] = std::nextafter(float(b.max[k]), HUGE_VALF);
           }
         }
+        for_cells(verify_boxes_[t], [&](size_t c) {
+          if (pass == 0) ++verify_start_[c + 1];
+          else verify_entries_[verify_cursor_[c]++] = t;
+        });
+      }
+      if (pass == 0) {
+        for (size_t c = 0; c + 1 < verify_start_.size(); ++c) verify_start_[c + 1] += verify_start_[c];
+        verify_entries_.resize(verify_start_.back());
+        verify_cursor_.assign(verify_start_.begin(), verify_start_.end() - 1);
+      }
+    }
+    // Graph states of the changed triangles' vertices, from their fans as they are now.
+    verify_axis_.assign(pos_.size(), kNotWorkedOut);
+    auto graph_fan = [&](uint32_t v) {
+      if (verify_axis_[v] == kNotWorkedOut) {
+        verify_axis_[v] = kUnknownAxis;
+        fan_scratch_.clear();
+        if (vertex_alive_[v] && walk_fan(v, nullptr, &fan_scratch_))
+          verify_axis_[v] = graph_state(pos_[v], fan_scratch_, [](uint32_t x) { return x; }, [&](uint32_t x) { return pos_[x]; });
+      }
+      return verify_axis_[v] != kUnknownAxis;
+    };
+    auto shares_graph_fan = [&](const std::array<uint32_t, 3>& x, const std::array<uint32_t, 3>& y) {
+      for (uint32_t v : x)
+        if ((v == y[0] || v == y[1] || v == y[2]) && graph_fan(v)) return true;
+      return false;
+    };
+    stamp_.assign(nt, 0);
+    stamp_now_ = 0;
+    for (uint32_t t = 0; t < nt; ++t) {
+      if (!tri_alive_[t] || !tri_changed_[t]) continue;
+      const auto& ids = tri_[t];
+      const std::array<Vec3d, 3> tp{pos_[ids[0]], pos_[ids[1]], pos_[ids[2]]};
+      const Entry& te = verify_boxes_[t];
+      const Box3 tb{{te.lo[0], te.lo[1], te.lo[2]}, {te.hi[0], te.hi[1], te.hi[2]}};
+      next_stamp();
+      bool crossed = false;
+      for_cells(te, [&](size_t c) {
+        for (uint32_t i = verify_start_[c]; i < verify_start_[c + 1] && !crossed; ++i) {
+          const uint32_t u = verify_entries_[i];
+          // A pair of changed triangles is tested from the lower one.
+          if (u == t || (tri_changed_[u] && u < t) || stamp_[u] == stamp_now_ || !overlaps(verify_boxes_[u], tb))
+            continue;
+          stamp_[u] = stamp_now_;
+          const auto& uids = tri_[u];
+          if (shares_graph_fan(ids, uids)) continue;
+          crossed = exact::faces_intersect(tp, ids, {pos_[uids[0]], pos_[uids[1]], pos_[uids[2]]}, uids);
+        }
       });
-      if (hit) return false;
+      if (crossed) return false;
     }
     return true;
   }
 
   // Writes the moved vertices' positions and quadrics back (unlocked ones only: no other region
-  // touches them) and appends the triangles this region owns.
-  void store_global(std::vector<Vec3d>& positions, std::vector<Quadric>& quadrics, std::vector<uint8_t>& has_quadric,
-                    std::vector<std::array<uint32_t, 3>>& out_tris) const {
+  // touches them), appends the triangles this region owns and the changes of the vertices' debts
+  // (a locked vertex may take debts in several regions: the caller adds them up in order).
+  void store_global(Vertices& vertices, std::vector<std::array<uint32_t, 3>>& out_tris,
+                    std::vector<std::pair<uint32_t, double>>& debt_changes) const {
     for (size_t v = 0; v < pos_.size(); ++v) {
-      if (!moved_[v]) continue;
       const uint32_t g = global_vertex_[v];
-      positions[g] = pos_[v];
-      quadrics[g] = quadric_[v];
-      has_quadric[g] = 1;
+      if (debt_[v] != debt_start_[v]) debt_changes.push_back({g, debt_[v] - debt_start_[v]});
+      if (!moved_[v]) continue;
+      vertices.positions[g] = pos_[v];
+      vertices.quadrics[g] = quadric_[v];
+      vertices.has_quadric[g] = 1;
     }
     for (size_t i = 0; i < tri_.size(); ++i) {
       if (!tri_alive_[i]) continue;
@@ -347,6 +428,7 @@ class RegionSimplifier {
       out.keys.push_back(block.keys[v]);
       out.quadrics.push_back(quadric_[v]);
       out.has_quadric.push_back(moved_[v]);
+      out.debt6.push_back(debt_[v]);
     }
     for (size_t i = 0; i < tri_.size(); ++i)
       if (tri_alive_[i]) out.triangles.push_back({index[tri_[i][0]], index[tri_[i][1]], index[tri_[i][2]]});
@@ -357,6 +439,7 @@ class RegionSimplifier {
 
  private:
   static constexpr uint8_t kUnknownAxis = 0xff;  // graph_axis_: 2 * axis + (sign < 0), or unknown
+  static constexpr uint8_t kNotWorkedOut = 0xfe;  // verify_axis_: not needed yet
   static constexpr int kMaxCells = 32;           // grid cells per axis of a region
   struct Entry {
     float lo[3], hi[3];
@@ -370,6 +453,9 @@ class RegionSimplifier {
   void init() {
     const size_t nt = tri_.size(), nv = pos_.size();
     tri_alive_.assign(nt, 1);
+    tri_changed_.assign(nt, 0);
+    quality2_.resize(nt);
+    for (size_t i = 0; i < nt; ++i) quality2_[i] = quality2(pos_[tri_[i][0]], pos_[tri_[i][1]], pos_[tri_[i][2]]);
     vertex_alive_.assign(nv, 1);
     version_.assign(nv, 0);
     degree_.assign(nv, 0);
@@ -570,6 +656,8 @@ class RegionSimplifier {
 
   Vec3d at(uint32_t v, uint32_t keep, const Vec3d& target) const { return v == keep ? target : pos_[v]; }
 
+
+
   // Whether the fan around p, given as corners (centre, next, previous) after `rename` and with
   // positions from `position`, projects one-to-one onto the coordinate plane orthogonal to axis
   // k with orientation sign s: then 2k + (s < 0), else kUnknownAxis. The projected faces must all
@@ -666,23 +754,27 @@ class RegionSimplifier {
       if (tri_of(c) != t1 && tri_of(c) != t2) new_fan_.push_back(c);
     auto rename = [&](uint32_t x) { return x == drop ? keep : x; };
 
-    // A free vertex goes where the quadric is least among the positions that keep the enclosed
-    // volume (the new fan's volume is linear in its position), unless that costs more than the
-    // tolerance; then to the plain minimiser.
+    // A free vertex goes where the quadric is least among the positions that give the enclosed
+    // volume its due (the volume before plus the two ends' debts; the new fan's volume is linear
+    // in its position), unless that costs more than the tolerance; then to the plain minimiser.
     const Quadric q = quadric_[keep] + quadric_[drop];
     Vec3d target = first_target(keep, drop, q);
+    const Vec3d mid = (pos_[keep] + pos_[drop]) * 0.5;
+    Vec3d n;
+    double old6 = 0;
+    for (uint32_t c : keep_corners_)
+      old6 += dot(pos_[keep] - mid, cross(pos_[to(c)] - mid, pos_[from(prev_he(c))] - mid));
+    for (uint32_t c : drop_corners_)
+      if (tri_of(c) != t1 && tri_of(c) != t2)
+        old6 += dot(pos_[drop] - mid, cross(pos_[to(c)] - mid, pos_[from(prev_he(c))] - mid));
+    for (uint32_t c : new_fan_) n += cross(pos_[to(c)] - mid, pos_[from(prev_he(c))] - mid);
+    // On a flat stretch the volume can only be given back by leaving its plane: the debt waits for
+    // a curved one (a flat face stays flat, to the bit, for node sets and slicers).
+    const double owed6 = debt_[keep] + debt_[drop];
+    const double paid6 = q.flat() ? 0.0 : owed6;
     if (!locked_[keep]) {
-      const Vec3d mid = (pos_[keep] + pos_[drop]) * 0.5;
-      Vec3d n;
-      double old6 = 0;
-      for (uint32_t c : keep_corners_)
-        old6 += dot(pos_[keep] - mid, cross(pos_[to(c)] - mid, pos_[from(prev_he(c))] - mid));
-      for (uint32_t c : drop_corners_)
-        if (tri_of(c) != t1 && tri_of(c) != t2)
-          old6 += dot(pos_[drop] - mid, cross(pos_[to(c)] - mid, pos_[from(prev_he(c))] - mid));
-      for (uint32_t c : new_fan_) n += cross(pos_[to(c)] - mid, pos_[from(prev_he(c))] - mid);
       Vec3d volume_target;
-      if (q.minimiser_on_plane(mid, n, old6 + dot(n, mid), volume_target) &&
+      if (q.minimiser_on_plane(mid, n, old6 + paid6 + dot(n, mid), volume_target) &&
           q.error(round_to_output(volume_target)) <= tolerance2_)
         target = volume_target;
       target = round_to_output(target);
@@ -694,10 +786,10 @@ class RegionSimplifier {
     // The triangles that change: drop's (renamed), and keep's when keep moves. None may be worse
     // shaped than the worst it replaces unless it stays above kMinQuality: exact tests keep even a
     // needle valid, but slicers, viewers and meshers recompute its normal in float and trip on it.
-    double old_quality = std::min(quality(pos_[tri_[t1][0]], pos_[tri_[t1][1]], pos_[tri_[t1][2]]),
-                                  quality(pos_[tri_[t2][0]], pos_[tri_[t2][1]], pos_[tri_[t2][2]]));
-    double new_quality = HUGE_VAL;
+    double old_quality2 = std::min(quality2_[t1], quality2_[t2]);
+    double new_quality2 = HUGE_VAL;
     changed_.clear();
+    changed_quality2_.clear();
     changed_ids_.clear();
     changed_pos_.clear();
     changed_box_.clear();
@@ -712,15 +804,16 @@ class RegionSimplifier {
       const Vec3d n_old = cross(pos_[old[1]] - pos_[old[0]], pos_[old[2]] - pos_[old[0]]);
       const Vec3d n_new = cross(p[1] - p[0], p[2] - p[0]);
       if (dot(n_old, n_new) <= cos_normal_ * norm(n_old) * norm(n_new)) return false;
-      old_quality = std::min(old_quality, quality(pos_[old[0]], pos_[old[1]], pos_[old[2]]));
-      new_quality = std::min(new_quality, quality(p[0], p[1], p[2]));
+      old_quality2 = std::min(old_quality2, quality2_[t]);
+      changed_quality2_.push_back(quality2(p[0], p[1], p[2]));
+      new_quality2 = std::min(new_quality2, changed_quality2_.back());
       changed_.push_back(t);
       changed_ids_.push_back(ids);
       changed_pos_.push_back(p);
       changed_box_.push_back(tri_box(p));
     }
 
-    if (new_quality < std::min(kMinQuality, old_quality)) return false;
+    if (new_quality2 < std::min(kMinQuality * kMinQuality, old_quality2)) return false;
 
     // Pairs sharing a vertex whose fan is a graph over a coordinate plane meet only in what they
     // share. keep's new fan is checked whole; a neighbour whose fan was a graph stays one when
@@ -819,14 +912,19 @@ class RegionSimplifier {
         bool walked = false;
         for (uint8_t i = 0; i < represented_count_[r]; ++i) {
           Represented& point = represented_[r][i];
-          // The triangle it was last found near first: usually still near, or untouched.
+          // The triangle it was last found near first: usually untouched (then still near), or
+          // still near.
           const uint32_t last = point.near;
           if (last != kNone && last != t1 && last != t2 && tri_alive_[last]) {
             const auto& t = tri_[last];
-            if ((t[0] == r || t[1] == r || t[2] == r) &&
-                within_deviation(point.at, at(rename(t[0]), keep, target), at(rename(t[1]), keep, target),
-                                 at(rename(t[2]), keep, target)))
-              continue;
+            if (t[0] == r || t[1] == r || t[2] == r) {
+              const bool has_drop = t[0] == drop || t[1] == drop || t[2] == drop;
+              const bool has_keep = t[0] == keep || t[1] == keep || t[2] == keep;
+              if (!has_drop && !(keep_moves && has_keep)) continue;
+              if (within_deviation(point.at, at(rename(t[0]), keep, target), at(rename(t[1]), keep, target),
+                                   at(rename(t[2]), keep, target)))
+                continue;
+            }
           }
           if (!walked) {
             ring_corners_.clear();
@@ -868,11 +966,21 @@ class RegionSimplifier {
         }
       return false;
     };
-    for (size_t i = 0; i < changed_.size(); ++i)
+    // A changed triangle is its old self with one corner (drop, or keep) moved to the target, so
+    // its centroid is within a third of that move of the old one, and the midpoint of its edge
+    // from the target within half of it: no search when that is within the deviation.
+    const double moved_drop = norm(target - pos_[drop]), moved_keep = norm(target - pos_[keep]);
+    for (size_t i = 0; i < changed_.size(); ++i) {
+      const auto& old = tri_[changed_[i]];
+      const bool of_drop = old[0] == drop || old[1] == drop || old[2] == drop;
+      if ((of_drop ? moved_drop : moved_keep) <= 3 * max_deviation_) continue;
       if (!near_old_surface((changed_pos_[i][0] + changed_pos_[i][1] + changed_pos_[i][2]) / 3.0, changed_[i]))
         return false;
-    for (uint32_t c : new_fan_)
+    }
+    for (uint32_t c : new_fan_) {
+      if ((from(c) == drop ? moved_drop : moved_keep) <= 2 * max_deviation_) continue;
       if (!near_old_surface((target + pos_[rename(to(c))]) * 0.5, tri_of(c))) return false;
+    }
 
     next_stamp_for_collapse(t1, t2);
     bool hit = false;
@@ -937,6 +1045,10 @@ class RegionSimplifier {
     for (uint32_t x : {h, h1, h2, g, g1, g2}) opp_[x] = kNone;
     for (uint32_t c : drop_corners_) tri_[tri_of(c)][c & 3] = keep;
     tri_alive_[t1] = tri_alive_[t2] = 0;
+    for (size_t i = 0; i < changed_.size(); ++i) {
+      tri_changed_[changed_[i]] = 1;
+      quality2_[changed_[i]] = changed_quality2_[i];
+    }
     vertex_alive_[drop] = 0;
     corner_[drop] = kNone;
     corner_[keep] = o2;  // now keep -> a
@@ -947,6 +1059,8 @@ class RegionSimplifier {
     degree_[b] -= 1;
     pos_[keep] = target;
     quadric_[keep] += quadric_[drop];
+    debt_[keep] = owed6 - (dot(target - mid, n) - old6);
+    debt_[drop] = 0;
     moved_[keep] = 1;
     // keep stands for the removed points farthest from it from now on.
     std::sort(removed_.begin(), removed_.end(), [&](const Represented& ru, const Represented& rw) {
@@ -983,7 +1097,11 @@ class RegionSimplifier {
   std::vector<std::array<uint32_t, 3>> tri_;
   std::vector<Vec3d> pos_;
   std::vector<Quadric> quadric_;
-  std::vector<uint8_t> own_quadric_, tri_alive_, vertex_alive_, locked_, graph_axis_;
+  std::vector<double> debt_, debt_start_;
+  std::vector<double> quality2_, changed_quality2_;  // quality2 of every triangle, and of the changed ones as they would be
+  std::vector<uint8_t> own_quadric_, tri_alive_, tri_changed_, vertex_alive_, locked_, graph_axis_, verify_axis_;
+  std::vector<Entry> verify_boxes_;
+  std::vector<uint32_t> verify_start_, verify_cursor_, verify_entries_;
   std::vector<uint32_t> version_, degree_, corner_, opp_;
   std::vector<uint64_t> table_keys_;
   std::vector<uint32_t> table_values_;
@@ -1031,9 +1149,9 @@ void simplify_region(RegionSimplifier& simplifier, Load&& load, SimplifyStats& s
 // least a region below the mesh) are simplified independently; a triangle belongs to every
 // region whose open box its box meets, and to the region holding its centroid (which is the one
 // that writes it).
-void simplify_pass(std::vector<Vec3d>& positions, std::vector<std::array<uint32_t, 3>>& triangles,
-                   std::vector<Quadric>& quadrics, std::vector<uint8_t>& has_quadric, const Vec3d& origin,
+void simplify_pass(Vertices& vertices, std::vector<std::array<uint32_t, 3>>& triangles, const Vec3d& origin,
                    double side, const SimplifyOptions& options, SimplifyStats& stats) {
+  const std::vector<Vec3d>& positions = vertices.positions;
   auto boundary = [&](int k, int64_t i) { return origin[k] + double(i) * side; };
   auto index_of = [&](int k, double v) { return std::max<int64_t>(0, int64_t(std::floor((v - origin[k]) / side))); };
   auto pack = [](int64_t i, int64_t j, int64_t k) { return (uint64_t(i) << 42) | (uint64_t(j) << 21) | uint64_t(k); };
@@ -1091,6 +1209,7 @@ void simplify_pass(std::vector<Vec3d>& positions, std::vector<std::array<uint32_
   const size_t regions = region_start.size() - 1;
 
   std::vector<std::vector<std::array<uint32_t, 3>>> out(regions);
+  std::vector<std::vector<std::pair<uint32_t, double>>> debt_changes(regions);
   std::vector<SimplifyStats> region_stats(regions);
   Progress progress("simplify", regions);
   tbb::enumerable_thread_specific<RegionSimplifier> simplifiers(options);
@@ -1104,16 +1223,15 @@ void simplify_pass(std::vector<Vec3d>& positions, std::vector<std::array<uint32_
       const int64_t ri = int64_t(key >> 42), rj = int64_t((key >> 21) & 0x1fffff), rk = int64_t(key & 0x1fffff);
       const RegionBox box{{boundary(0, ri), boundary(1, rj), boundary(2, rk)},
                           {boundary(0, ri + 1), boundary(1, rj + 1), boundary(2, rk + 1)}};
-      simplify_region(
-          simplifier, [&] { simplifier.load_global(box, triangles, ids, positions, quadrics, has_quadric); },
-          region_stats[r]);
-      simplifier.store_global(positions, quadrics, has_quadric, out[r]);
+      simplify_region(simplifier, [&] { simplifier.load_global(box, triangles, ids, vertices); }, region_stats[r]);
+      simplifier.store_global(vertices, out[r], debt_changes[r]);
       progress.advance();
     }
   });
   triangles.clear();
   for (size_t r = 0; r < regions; ++r) {
     triangles.insert(triangles.end(), out[r].begin(), out[r].end());
+    for (const auto& [v, change] : debt_changes[r]) vertices.debt6[v] += change;
     stats.collapses += region_stats[r].collapses;
     stats.rejected_by_intersection += region_stats[r].rejected_by_intersection;
     stats.regions_redone += region_stats[r].regions_redone;
@@ -1150,7 +1268,8 @@ TriMesh simplify_mesh(const TriMesh& mesh, const SimplifyOptions& options, Simpl
   check_options(options);
   SimplifyStats stats;
   stats.input_triangles = mesh.triangles.size();
-  std::vector<Vec3d> positions(mesh.positions_mm.size());
+  Vertices vertices(mesh.positions_mm.size());
+  std::vector<Vec3d>& positions = vertices.positions;
   for (size_t v = 0; v < positions.size(); ++v) positions[v] = round_to_output(mesh.positions_mm[v]);
   std::vector<std::array<uint32_t, 3>> triangles = mesh.triangles;
   Box3 box;
@@ -1171,12 +1290,9 @@ TriMesh simplify_mesh(const TriMesh& mesh, const SimplifyOptions& options, Simpl
     side = std::clamp(std::sqrt(20000.0 * area / double(triangles.size())), extent / 64, std::max(extent / 2, 1e-9));
     if (!(side > 0)) side = 1;
   }
-  std::vector<Quadric> quadrics(positions.size());
-  std::vector<uint8_t> has_quadric(positions.size(), 0);
   const Vec3d origin = box.min - Vec3d{side, side, side} * 1.25;
-  simplify_pass(positions, triangles, quadrics, has_quadric, origin, side, options, stats);
-  simplify_pass(positions, triangles, quadrics, has_quadric, origin - Vec3d{side, side, side} * 0.5, side, options,
-                stats);
+  simplify_pass(vertices, triangles, origin, side, options, stats);
+  simplify_pass(vertices, triangles, origin - Vec3d{side, side, side} * 0.5, side, options, stats);
   TriMesh out = compact(positions, triangles);
   stats.output_triangles = out.triangles.size();
   if (stats_out) *stats_out = stats;
@@ -1187,7 +1303,9 @@ TriMesh extract_simplified_surface(const Volume& volume, const SimplifyOptions& 
   check_options(options);
   SimplifyStats stats;
   constexpr int kBlockVoxels = 32;
-  const BlockExtractor extractor(volume, kBlockVoxels);
+  ExtractOptions extract;
+  extract.merge_deviation_mm = options.merge_fraction * options.max_deviation_mm;
+  const BlockExtractor extractor(volume, kBlockVoxels, extract);
   const size_t blocks = extractor.block_count();
   std::vector<BlockResult> results(blocks);
   std::vector<SimplifyStats> block_stats(blocks);
@@ -1200,7 +1318,8 @@ TriMesh extract_simplified_surface(const Volume& volume, const SimplifyOptions& 
       SurfaceBlock& block = surface_blocks.local();
       for (size_t i = range.begin(); i != range.end(); ++i) {
         extractor.extract(i, block);
-        block_stats[i].input_triangles = block.triangles.size();
+        block_stats[i].input_triangles = block.piece_triangles;
+        block_stats[i].merged_triangles = block.triangles.size();
         if (!block.triangles.empty()) {
           simplify_region(simplifier, [&] { simplifier.load_block(block); }, block_stats[i]);
           simplifier.store_block(block, results[i]);
@@ -1209,54 +1328,40 @@ TriMesh extract_simplified_surface(const Volume& volume, const SimplifyOptions& 
       }
     });
   }
-  // Global numbering: the blocks' interior vertices in block order, then the vertices on block
-  // faces once per grid edge, in key order.
-  std::vector<uint64_t> first_interior(blocks + 1, 0);
-  size_t boundary_count = 0;
   for (size_t i = 0; i < blocks; ++i) {
-    size_t interior = 0;
-    for (uint64_t key : results[i].keys) interior += key == kInteriorVertex;
-    first_interior[i + 1] = first_interior[i] + interior;
-    boundary_count += results[i].keys.size() - interior;
     stats.input_triangles += block_stats[i].input_triangles;
+    stats.merged_triangles += block_stats[i].merged_triangles;
     stats.collapses += block_stats[i].collapses;
     stats.rejected_by_intersection += block_stats[i].rejected_by_intersection;
     stats.regions_redone += block_stats[i].regions_redone;
     stats.regions += results[i].triangles.empty() ? 0 : 1;
   }
-  std::vector<uint64_t> boundary_keys;
-  boundary_keys.reserve(boundary_count);
-  for (const BlockResult& r : results)
-    for (uint64_t key : r.keys)
-      if (key != kInteriorVertex) boundary_keys.push_back(key);
-  tbb::parallel_sort(boundary_keys.begin(), boundary_keys.end());
-  boundary_keys.erase(std::unique(boundary_keys.begin(), boundary_keys.end()), boundary_keys.end());
-  const uint64_t total = first_interior[blocks] + boundary_keys.size();
-  if (total >= kNone) throw std::length_error("surface has more than 4 billion vertices");
-  std::vector<Vec3d> positions(total);
-  std::vector<Quadric> quadrics(total);
-  std::vector<uint8_t> has_quadric(total, 0);
+  std::vector<const std::vector<uint64_t>*> keys(blocks);
+  for (size_t i = 0; i < blocks; ++i) keys[i] = &results[i].keys;
+  std::vector<std::vector<uint32_t>> global;
+  const uint64_t total = number_block_vertices(keys, global);
+  Vertices vertices(total);
+  std::vector<Vec3d>& positions = vertices.positions;
+  // A vertex on a block face owes what every block that has it owes: added up in block order.
+  for (size_t i = 0; i < blocks; ++i)
+    for (size_t v = 0; v < results[i].positions.size(); ++v)
+      if (results[i].keys[v] != kInteriorVertex) vertices.debt6[global[i][v]] += results[i].debt6[v];
   std::vector<std::vector<std::array<uint32_t, 3>>> block_tris(blocks);
   tbb::parallel_for(size_t(0), blocks, [&](size_t i) {
     BlockResult& r = results[i];
-    std::vector<uint32_t> global(r.positions.size());
-    uint64_t next = first_interior[i];
+    const std::vector<uint32_t>& g = global[i];
     for (size_t v = 0; v < r.positions.size(); ++v) {
-      uint64_t g;
+      positions[g[v]] = r.positions[v];  // a shared vertex is the same float triple from every block
       if (r.keys[v] == kInteriorVertex) {
-        g = next++;
-        quadrics[g] = r.quadrics[v];
-        has_quadric[g] = r.has_quadric[v];
-      } else {
-        g = first_interior[blocks] +
-            uint64_t(std::lower_bound(boundary_keys.begin(), boundary_keys.end(), r.keys[v]) - boundary_keys.begin());
+        vertices.quadrics[g[v]] = r.quadrics[v];
+        vertices.has_quadric[g[v]] = r.has_quadric[v];
+        vertices.debt6[g[v]] = r.debt6[v];
       }
-      positions[g] = r.positions[v];  // a shared vertex is the same float triple from every block
-      global[v] = uint32_t(g);
     }
     block_tris[i].reserve(r.triangles.size());
-    for (const auto& t : r.triangles) block_tris[i].push_back({global[t[0]], global[t[1]], global[t[2]]});
+    for (const auto& t : r.triangles) block_tris[i].push_back({g[t[0]], g[t[1]], g[t[2]]});
     r = BlockResult();
+    std::vector<uint32_t>().swap(global[i]);
   });
   std::vector<std::array<uint32_t, 3>> triangles;
   {
@@ -1268,14 +1373,15 @@ TriMesh extract_simplified_surface(const Volume& volume, const SimplifyOptions& 
       std::vector<std::array<uint32_t, 3>>().swap(b);
     }
   }
-  // Across the block faces: regions of the same size, shifted by half a block.
+  // Across the block faces: regions of the same size, shifted by half a block, so each holds a
+  // meeting point of eight blocks in its middle.
   if (!triangles.empty()) {
     const double side = kBlockVoxels * volume.voxel_size_mm();
     Box3 box;
     for (const Vec3d& p : positions) box.expand(p);
     Vec3d origin;
     for (int k = 0; k < 3; ++k) origin[k] = (std::floor(box.min[k] / side) - 1.5) * side;
-    simplify_pass(positions, triangles, quadrics, has_quadric, origin, side, options, stats);
+    simplify_pass(vertices, triangles, origin, side, options, stats);
   }
   TriMesh out = compact(positions, triangles);
   stats.output_triangles = out.triangles.size();

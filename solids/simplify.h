@@ -18,10 +18,15 @@ struct SimplifyOptions {
   // Side of the independent regions (mm); 0 picks one from the mesh so that each holds a few tens
   // of thousands of triangles.
   double region_mm = 0;
+  // extract_simplified_surface only: the share of the deviation the cubes' pieces may be merged
+  // within as they are extracted (ExtractOptions::merge_deviation_mm); the collapses keep to the
+  // rest. 0 extracts the marching-tetrahedra pieces unmerged.
+  double merge_fraction = 0.25;
 };
 
 struct SimplifyStats {
-  uint64_t input_triangles = 0;
+  uint64_t input_triangles = 0;   // of the marching-tetrahedra surface
+  uint64_t merged_triangles = 0;  // extract_simplified_surface: after the cubes' pieces were merged
   uint64_t output_triangles = 0;
   uint64_t collapses = 0;
   uint64_t rejected_by_intersection = 0;  // collapses the exact guard refused

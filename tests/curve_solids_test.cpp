@@ -184,18 +184,23 @@ TEST(CurveSolids, SmallCavitiesAndSpecksAreRemovedLargeOnesKept) {
   add_box({0, 0, 0}, 10, false);
   add_box({2, 2, 2}, 0.1, true);
   add_box({5, 5, 5}, 1, true);
-  EXPECT_EQ(fill_small_cavities(m, 0.01), 1u);
+  SmallShells removed = remove_small_shells(m, 0.01);
+  EXPECT_EQ(removed.cavities, 1u);
+  EXPECT_EQ(removed.specks, 0u);
   EXPECT_EQ(m.triangles.size(), 24u);
   EXPECT_EQ(m.positions_mm.size(), 16u);
   EXPECT_NEAR(signed_volume(m), 1000 - 1, 1e-9);
-  EXPECT_EQ(fill_small_cavities(m, 0.01), 0u);
+  removed = remove_small_shells(m, 0.01);
+  EXPECT_EQ(removed.cavities + removed.specks, 0u);
   // Specks: a separate 0.001 mm^3 cube goes, a 1 mm^3 one stays; the cavity is no speck.
   add_box({20, 0, 0}, 0.1, false);
   add_box({30, 0, 0}, 1, false);
-  EXPECT_EQ(remove_small_specks(m, 0.01), 1u);
+  removed = remove_small_shells(m, 0.01);
+  EXPECT_EQ(removed.cavities, 0u);
+  EXPECT_EQ(removed.specks, 1u);
   EXPECT_EQ(m.triangles.size(), 36u);
   EXPECT_NEAR(signed_volume(m), 1000 - 1 + 1, 1e-9);
-  EXPECT_EQ(remove_small_specks(m, 0.01), 0u);
+  EXPECT_EQ(remove_small_shells(m, 0.01).specks, 0u);
 }
 
 }  // namespace

@@ -296,6 +296,28 @@ TEST(Fea, FormatsReadBack) {
     if (tets.nodes_mm[i].z == 10) on_top.insert(i + 1);
   EXPECT_EQ(listed, on_top);
   EXPECT_GE(on_top.size(), 4u);
+  // With a node set tolerance, a top node lowered by less than it stays in NZMAX, one lowered by
+  // more leaves it (the cube's box is still 10 high: the other top nodes hold it).
+  auto nzmax = [&](const std::string& text) {
+    const size_t from = text.find("*NSET, NSET=NZMAX\n");
+    std::string b = text.substr(from + 18, text.find('*', from + 1) - from - 18);
+    std::replace(b.begin(), b.end(), '\n', ',');
+    std::stringstream list(b);
+    std::set<size_t> ids;
+    for (std::string i; std::getline(list, i, ',');)
+      if (i.find_first_not_of(" \n") != std::string::npos) ids.insert(std::stoul(i));
+    return ids;
+  };
+  TetMesh lowered = tets;
+  const size_t a = *on_top.begin() - 1, b = *std::next(on_top.begin()) - 1;
+  lowered.nodes_mm[a].z -= 0.01;
+  lowered.nodes_mm[b].z -= 0.03;
+  FeaWriteOptions tolerant;
+  tolerant.node_set_tolerance_mm = 0.02;
+  write_fea(dir / "t.inp", FeaFormat::kInp, lowered, tolerant);
+  std::set<size_t> expected = on_top;
+  expected.erase(b + 1);
+  EXPECT_EQ(nzmax(read_text(dir / "t.inp")), expected);
 
   // C3D10: one mid-side node per edge of the mesh.
   FeaWriteOptions quadratic;

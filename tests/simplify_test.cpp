@@ -10,6 +10,8 @@
 #include "cifs/solid_input.h"
 #include "recipe/cifs_system.h"
 #include "errors.h"
+#include "pipeline/mesh_object.h"
+#include "recipe/recipe.h"
 #include "solids/check.h"
 #include "solids/extract.h"
 #include "solids/mesh_distance.h"
@@ -140,6 +142,45 @@ TEST(Simplify, NearlyTouchingSpheresStayApart) {
   const TriMesh plain = extract_surface(volume);
   const MeshCheckReport before = check_mesh(plain);
   const MeshCheckReport after = check_mesh(extract_simplified_surface(volume, options, &stats));
+  EXPECT_TRUE(after.valid()) << ::testing::PrintToString(after.problems());
+  EXPECT_EQ(after.components, before.components);
+  EXPECT_EQ(after.genus, before.genus);
+}
+
+TEST(Simplify, NearlyTouchingSpheresStayApartBesideABlockFace) {
+  // The same, with the gap on the grid planes 1 to 7 voxels from a block face (blocks of 32
+  // voxels: x = 3.2 mm), where the block and the pass across the block faces share the work.
+  const double h = 0.1, r = 2;
+  for (int voxels = 1; voxels <= 7; ++voxels) {
+    const double gap_x = 3.2 + voxels * h;
+    GeometrySet set = sphere({gap_x - r - h / 6, 0.01, 0.02}, r);
+    set.spheres.centers_mm.push_back({gap_x + r + h / 6, 0.01, 0.02});
+    set.spheres.radii_mm.push_back(r);
+    SimplifyOptions options;
+    options.max_deviation_mm = 2 * h;
+    const Volume volume = voxelize(set, VolumeOptions{h, 3.0});
+    const MeshCheckReport after = check_mesh(extract_simplified_surface(volume, options));
+    EXPECT_TRUE(after.valid()) << voxels << " voxels: " << ::testing::PrintToString(after.problems());
+    EXPECT_EQ(after.components, 2u) << voxels;
+  }
+}
+
+TEST(Simplify, ThinWallsNearBlockFacesStayApart) {
+  // A corner of a lacunar cube at level 3: walls of one or two voxels and tunnels everywhere, many
+  // across the block faces (a pass across them that loaded only the triangles near the faces once
+  // let a collapse push a wall through one it had not loaded).
+  const Recipe recipe = parse_recipe(R"({"lacuna_recipe": 1, "name": "corner", "voxel_size_mm": 0.12,
+    "inputs": {"cube": {"type": "bcifs_volume", "cell": "hexahedron", "edge_mm": 24, "level": 3, "edge": "B2",
+                        "params": "B2 B2 B2", "lacuna_scale": 0.5, "face_lacuna_scale": 0.5},
+               "clip": {"type": "box", "min_mm": [6, -13, -0.5], "max_mm": [13, -6, 6.5]}},
+    "operations": [{"name": "part", "op": "intersection", "of": ["cube", "clip"]}],
+    "outputs": [{"of": "part", "file": "part.stl"}]})", "corner.json");
+  const Volume volume = evaluate_object(recipe, "part");
+  SimplifyOptions options;
+  options.max_deviation_mm = 0.2 * 0.12;
+  const TriMesh plain = extract_surface(volume);
+  const MeshCheckReport before = check_mesh(plain);
+  const MeshCheckReport after = check_mesh(extract_simplified_surface(volume, options));
   EXPECT_TRUE(after.valid()) << ::testing::PrintToString(after.problems());
   EXPECT_EQ(after.components, before.components);
   EXPECT_EQ(after.genus, before.genus);

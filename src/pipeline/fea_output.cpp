@@ -54,15 +54,16 @@ TetCheck write_tetrahedra(const std::string& mesh_path, const std::string& outpu
     simplify.max_deviation_mm = simplify_mm;
     surface = simplify_mesh(surface, simplify);
   }
-  return write_tetrahedra(surface, output_path, settings);
+  return write_tetrahedra(surface, output_path, settings, std::max(0.0, simplify_mm));
 }
 
-TetCheck write_tetrahedra(const TriMesh& surface, const std::string& output_path, const FeaSettings& settings) {
+TetCheck write_tetrahedra(const TriMesh& surface, const std::string& output_path, const FeaSettings& settings,
+                          double deviation_mm) {
   FeaResult fea = make_fea_mesh(surface, settings);
   if (!fea.check.valid()) return fea.check;
   OutputTransaction transaction;
   try {
-    write_fea(transaction.stage(output_path), fea_format_from_path(output_path), fea.mesh, fea_write_options(settings));
+    write_fea(transaction.stage(output_path), fea_format_from_path(output_path), fea.mesh, fea_write_options(settings, deviation_mm));
     transaction.commit();
   } catch (const IoError& e) {
     // Named as the file asked for, not its hidden temporary.
@@ -71,10 +72,11 @@ TetCheck write_tetrahedra(const TriMesh& surface, const std::string& output_path
   return fea.check;
 }
 
-FeaWriteOptions fea_write_options(const FeaSettings& settings) {
+FeaWriteOptions fea_write_options(const FeaSettings& settings, double deviation_mm) {
   FeaWriteOptions w;
   w.msh_version_2 = settings.msh_version_2;
   w.quadratic = settings.quadratic;
+  w.node_set_tolerance_mm = deviation_mm;
   return w;
 }
 

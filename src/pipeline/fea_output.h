@@ -39,11 +39,14 @@ FeaResult make_fea_mesh(const TriMesh& surface, const FeaSettings& settings,
 TetCheck write_tetrahedra(const std::string& mesh_path, const std::string& output_path, const FeaSettings& settings,
                           double simplify_mm = 0);
 
-// The same for a surface in memory (not simplified here).
-TetCheck write_tetrahedra(const TriMesh& surface, const std::string& output_path, const FeaSettings& settings);
+// The same for a surface in memory (not simplified here; `deviation_mm`: how far it was simplified,
+// which the node sets allow for).
+TetCheck write_tetrahedra(const TriMesh& surface, const std::string& output_path, const FeaSettings& settings,
+                          double deviation_mm = 0);
 
-// How a tetrahedral output's settings ask for it to be written (Gmsh version, element order).
-FeaWriteOptions fea_write_options(const FeaSettings& settings);
+// How a tetrahedral output's settings ask for it to be written (Gmsh version, element order), for
+// a surface simplified to `deviation_mm` (the node sets take in the nodes that near the box's planes).
+FeaWriteOptions fea_write_options(const FeaSettings& settings, double deviation_mm);
 
 // The report entry of a tetrahedral output.
 nlohmann::json fea_report_json(const TetCheck& check);

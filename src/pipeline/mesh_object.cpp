@@ -94,8 +94,9 @@ ObjectMesh extract_object_surface(const Volume& volume, double simplify_mm) {
     result.extracted_triangles = result.mesh.triangles.size();
   }
   const double h = volume.voxel_size_mm();
-  result.subvoxel_cavities_filled = fill_small_cavities(result.mesh, h * h * h);
-  result.subvoxel_specks_removed = remove_small_specks(result.mesh, h * h * h);
+  const SmallShells removed = remove_small_shells(result.mesh, h * h * h);
+  result.subvoxel_cavities_filled = removed.cavities;
+  result.subvoxel_specks_removed = removed.specks;
   return result;
 }
 
