@@ -22,7 +22,6 @@ namespace {
 constexpr uint32_t kNone = UINT32_MAX;
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeviationMargin = 0.75;
-  // how near the block faces the pass across them looks
 // A triangle's shape: 4 sqrt(3) area over the sum of its squared edges, 1 when equilateral, 0 when
 // flat; collapses may not push the worst triangle they touch below this (see RegionSimplifier::collapse).
 constexpr double kMinQuality = 0.15;
@@ -307,38 +306,14 @@ class RegionSimplifier {
   // collapses). The boxes go into a grid of fixed cells, filled by counting.
   bool verify() {
     const size_t nt = tri_.size();
-    size_t live = 0;
-    for (uint8_t alive : tri_alive_) live += alive;
-    const int cells = int(std::clamp(std::sqrt(double(live) / 2.0), 4.0, double(kMaxCells)));
-    const Vec3d size = box_.hi - box_.lo;
-    double inv[3];
-    for (int k = 0; k < 3; ++k) inv[k] = cells / size[k];
-    auto coord = [&](double v, int k) { return int(std::clamp(std::floor((v - box_.lo[k]) * inv[k]), 0.0, double(cells - 1))); };
+    size_grid();
     verify_boxes_.resize(nt);
-    verify_start_.assign(size_t(cells) * cells * cells + 1, 0);
-    // Calls f(cell index) for every grid cell an entry's box reaches.
-    auto for_cells = [&](const Entry& e, auto&& f) {
-      int lo[3], hi[3];
-      for (int k = 0; k < 3; ++k) {
-        lo[k] = coord(e.lo[k], k);
-        hi[k] = coord(e.hi[k], k);
-      }
-      for (int x = lo[0]; x <= hi[0]; ++x)
-        for (int y = lo[1]; y <= hi[1]; ++y)
-          for (int z = lo[2]; z <= hi[2]; ++z) f(size_t((x * cells + y) * cells + z));
-    };
+    verify_start_.assign(size_t(cells_) * cells_ * cells_ + 1, 0);
     for (int pass = 0; pass < 2; ++pass) {
       for (uint32_t t = 0; t < nt; ++t) {
         if (!tri_alive_[t]) continue;
-        if (pass == 0) {
-          const auto& v = tri_[t];
-          const Box3 b = tri_box({pos_[v[0]], pos_[v[1]], pos_[v[2]]});
-          for (int k = 0; k < 3; ++k) {
-            verify_boxes_[t].lo[k] = std::nextafter(float(b.min[k]), -HUGE_VALF);
-            verify_boxes_[t].hi[k] = std::nextafter(float(b.max[k]), HUGE_VALF);
-          }
-        }
-        for_cells(verify_boxes_[t], [&](size_t c) {
+        if (pass == 0) verify_boxes_[t] = entry_of(t);
+        for_cells(box_of(verify_boxes_[t]), [&](size_t c) {
           if (pass == 0) ++verify_start_[c + 1];
           else verify_entries_[verify_cursor_[c]++] = t;
         });
@@ -371,11 +346,10 @@ class RegionSimplifier {
       if (!tri_alive_[t] || !tri_changed_[t]) continue;
       const auto& ids = tri_[t];
       const std::array<Vec3d, 3> tp{pos_[ids[0]], pos_[ids[1]], pos_[ids[2]]};
-      const Entry& te = verify_boxes_[t];
-      const Box3 tb{{te.lo[0], te.lo[1], te.lo[2]}, {te.hi[0], te.hi[1], te.hi[2]}};
+      const Box3 tb = box_of(verify_boxes_[t]);
       next_stamp();
       bool crossed = false;
-      for_cells(te, [&](size_t c) {
+      for_cells(tb, [&](size_t c) {
         for (uint32_t i = verify_start_[c]; i < verify_start_[c + 1] && !crossed; ++i) {
           const uint32_t u = verify_entries_[i];
           // A pair of changed triangles is tested from the lower one.
@@ -579,12 +553,7 @@ class RegionSimplifier {
   // A grid over the region's box holding every live triangle (triangles reaching outside it go
   // to the border cells).
   void build_grid() {
-    size_t live = 0;
-    for (uint8_t alive : tri_alive_) live += alive;
-    // About two live triangles per cell of a surface through the box: cells ~ live^(1/2) per axis.
-    cells_ = int(std::clamp(std::sqrt(double(live) / 2.0), 4.0, double(kMaxCells)));
-    const Vec3d size = box_.hi - box_.lo;
-    for (int k = 0; k < 3; ++k) inv_cell_[k] = cells_ / size[k];
+    size_grid();
     grid_.resize(size_t(cells_ * cells_ * cells_));
     for (auto& list : grid_) list.clear();
     grid_version_.assign(tri_.size(), 0);
@@ -593,6 +562,32 @@ class RegionSimplifier {
     for (uint32_t t = 0; t < tri_.size(); ++t)
       if (tri_alive_[t]) insert(t);
   }
+
+  // The cells of the grids over the region's box (build_grid's, verify's): about two live
+  // triangles per cell of a surface through the box, so cells ~ live^(1/2) per axis.
+  void size_grid() {
+    size_t live = 0;
+    for (uint8_t alive : tri_alive_) live += alive;
+    cells_ = int(std::clamp(std::sqrt(double(live) / 2.0), 4.0, double(kMaxCells)));
+    const Vec3d size = box_.hi - box_.lo;
+    for (int k = 0; k < 3; ++k) inv_cell_[k] = cells_ / size[k];
+  }
+
+  // t's box rounded outwards to float.
+  Entry entry_of(uint32_t t) const {
+    const auto& v = tri_[t];
+    const Box3 b = tri_box({pos_[v[0]], pos_[v[1]], pos_[v[2]]});
+    Entry e;
+    for (int k = 0; k < 3; ++k) {
+      e.lo[k] = std::nextafter(float(b.min[k]), -HUGE_VALF);
+      e.hi[k] = std::nextafter(float(b.max[k]), HUGE_VALF);
+    }
+    e.tri = t;
+    e.version = 0;
+    return e;
+  }
+
+  static Box3 box_of(const Entry& e) { return {{e.lo[0], e.lo[1], e.lo[2]}, {e.hi[0], e.hi[1], e.hi[2]}}; }
 
   int cell_coord(double v, int k) const {
     const double c = std::floor((v - box_.lo[k]) * inv_cell_[k]);
@@ -614,12 +609,7 @@ class RegionSimplifier {
   void insert(uint32_t t) {
     const auto& v = tri_[t];
     const Box3 b = tri_box({pos_[v[0]], pos_[v[1]], pos_[v[2]]});
-    Entry e;
-    for (int k = 0; k < 3; ++k) {
-      e.lo[k] = std::nextafter(float(b.min[k]), -HUGE_VALF);
-      e.hi[k] = std::nextafter(float(b.max[k]), HUGE_VALF);
-    }
-    e.tri = t;
+    Entry e = entry_of(t);
     e.version = ++grid_version_[t];
     for_cells(b, [&](size_t c) {
       std::vector<Entry>& list = grid_[c];
@@ -655,8 +645,6 @@ class RegionSimplifier {
   }
 
   Vec3d at(uint32_t v, uint32_t keep, const Vec3d& target) const { return v == keep ? target : pos_[v]; }
-
-
 
   // Whether the fan around p, given as corners (centre, next, previous) after `rename` and with
   // positions from `position`, projects one-to-one onto the coordinate plane orthogonal to axis
