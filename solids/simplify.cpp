@@ -213,8 +213,8 @@ struct Vertices {
 //
 // Two ways to guard: `guarded` tests every collapse against every triangle near it (a grid of
 // the region, updated as triangles change); otherwise a collapse is tested against the triangles
-// that share its vertices, and verify() then tests every pair of nearby triangles of the result
-// with exact predicates. A region whose result fails verify() is simplified again, guarded, from
+// that share its vertices, and verify() then tests the pairs of nearby triangles of the result
+// that share none with exact predicates. A region whose result fails verify() is simplified again, guarded, from
 // its input, so nothing untested leaves it either way; the second way is several times faster and
 // almost never has to redo a region.
 class RegionSimplifier {
@@ -300,10 +300,13 @@ class RegionSimplifier {
   }
 
   // Whether no two live triangles meet other than in the vertices or edge they share, given that
-  // the loaded triangles did not (the block of a valid surface, or a region of one): every pair
-  // with a changed triangle whose boxes overlap is tested exactly, except pairs sharing a vertex
-  // whose fan is a graph over a coordinate plane (worked out again here, not taken from the
-  // collapses). The boxes go into a grid of fixed cells, filled by counting.
+  // the loaded triangles did not (the block of a valid surface, or a region of one) and that
+  // every collapse tested its changed triangles against all triangles sharing a vertex with them:
+  // every pair with a changed triangle whose boxes overlap and that shares no vertex is tested
+  // exactly. (A pair that shares a vertex now either shared it when the later of its two changed,
+  // and that collapse tested it, or both hold the collapse's kept vertex and were tested with each
+  // other; a graph fan's pair stays apart as long as neither changes.) The boxes go into a grid
+  // of fixed cells, filled by counting.
   bool verify() {
     const size_t nt = tri_.size();
     size_grid();
@@ -324,22 +327,6 @@ class RegionSimplifier {
         verify_cursor_.assign(verify_start_.begin(), verify_start_.end() - 1);
       }
     }
-    // Graph states of the changed triangles' vertices, from their fans as they are now.
-    verify_axis_.assign(pos_.size(), kNotWorkedOut);
-    auto graph_fan = [&](uint32_t v) {
-      if (verify_axis_[v] == kNotWorkedOut) {
-        verify_axis_[v] = kUnknownAxis;
-        fan_scratch_.clear();
-        if (vertex_alive_[v] && walk_fan(v, nullptr, &fan_scratch_))
-          verify_axis_[v] = graph_state(pos_[v], fan_scratch_, [](uint32_t x) { return x; }, [&](uint32_t x) { return pos_[x]; });
-      }
-      return verify_axis_[v] != kUnknownAxis;
-    };
-    auto shares_graph_fan = [&](const std::array<uint32_t, 3>& x, const std::array<uint32_t, 3>& y) {
-      for (uint32_t v : x)
-        if ((v == y[0] || v == y[1] || v == y[2]) && graph_fan(v)) return true;
-      return false;
-    };
     stamp_.assign(nt, 0);
     stamp_now_ = 0;
     for (uint32_t t = 0; t < nt; ++t) {
@@ -357,7 +344,7 @@ class RegionSimplifier {
             continue;
           stamp_[u] = stamp_now_;
           const auto& uids = tri_[u];
-          if (shares_graph_fan(ids, uids)) continue;
+          if (shares_vertex(ids, uids)) continue;  // tested by the collapse that last changed either
           crossed = exact::faces_intersect(tp, ids, {pos_[uids[0]], pos_[uids[1]], pos_[uids[2]]}, uids);
         }
       });
@@ -413,7 +400,6 @@ class RegionSimplifier {
 
  private:
   static constexpr uint8_t kUnknownAxis = 0xff;  // graph_axis_: 2 * axis + (sign < 0), or unknown
-  static constexpr uint8_t kNotWorkedOut = 0xfe;  // verify_axis_: not needed yet
   static constexpr int kMaxCells = 32;           // grid cells per axis of a region
   struct Entry {
     float lo[3], hi[3];
@@ -537,6 +523,11 @@ class RegionSimplifier {
     b.min = {std::min({p[0].x, p[1].x, p[2].x}), std::min({p[0].y, p[1].y, p[2].y}), std::min({p[0].z, p[1].z, p[2].z})};
     b.max = {std::max({p[0].x, p[1].x, p[2].x}), std::max({p[0].y, p[1].y, p[2].y}), std::max({p[0].z, p[1].z, p[2].z})};
     return b;
+  }
+  static bool shares_vertex(const std::array<uint32_t, 3>& x, const std::array<uint32_t, 3>& y) {
+    for (uint32_t v : x)
+      if (v == y[0] || v == y[1] || v == y[2]) return true;
+    return false;
   }
   static bool overlaps(const Entry& e, const Box3& b) {
     return !(e.lo[0] > b.max.x || e.hi[0] < b.min.x || e.lo[1] > b.max.y || e.hi[1] < b.min.y || e.lo[2] > b.max.z ||
@@ -695,11 +686,6 @@ class RegionSimplifier {
     return exact::orient2d(v[i], v[j], a[i], a[j], b[i], b[j]) == sign;
   }
 
-  bool shares_graph_vertex(const std::array<uint32_t, 3>& x, const std::array<uint32_t, 3>& y) const {
-    for (uint32_t v : x)
-      if ((v == y[0] || v == y[1] || v == y[2]) && graph_axis_[v] != kUnknownAxis) return true;
-    return false;
-  }
 
   // Whether p lies within the deviation of triangle abc (its box first).
   bool within_deviation(const Vec3d& p, const Vec3d& a, const Vec3d& b, const Vec3d& c) const {
@@ -1087,7 +1073,7 @@ class RegionSimplifier {
   std::vector<Quadric> quadric_;
   std::vector<double> debt_, debt_start_;
   std::vector<double> quality2_, changed_quality2_;  // quality2 of every triangle, and of the changed ones as they would be
-  std::vector<uint8_t> own_quadric_, tri_alive_, tri_changed_, vertex_alive_, locked_, graph_axis_, verify_axis_;
+  std::vector<uint8_t> own_quadric_, tri_alive_, tri_changed_, vertex_alive_, locked_, graph_axis_;
   std::vector<Entry> verify_boxes_;
   std::vector<uint32_t> verify_start_, verify_cursor_, verify_entries_;
   std::vector<uint32_t> version_, degree_, corner_, opp_;
