@@ -555,6 +555,57 @@ TEST(Cli, CurvePointsAndFillRate) {
   EXPECT_GT(c["fill_rate"].get<double>(), 0.1);
   EXPECT_LT(c["fill_rate"].get<double>(), c["fill_rate_simple"].get<double>());
   EXPECT_EQ(lacuna("curve fill-rate --surface cylinder --samples 5", dir.path()).code, 2);
+  // On a B-spline patch: the flat 3 x 1 rectangle (bilinear, so the map is affine). H_1's cell
+  // centres go to (+-0.75, +-0.25); round-ended tubes of diameter 0.5 along it cover the middle
+  // 1.5 x 1, two half disks on the right, and on the left a 0.25 x 0.5 strip and two quarter disks:
+  // 1.625 + 3 pi / 32 of the area 3.
+  write_file(dir / "rectangle.json", R"({"degree_u": 1, "degree_v": 1, "count_u": 2, "count_v": 2,
+    "control_points_mm": [[-1.5, -0.5, 0], [1.5, -0.5, 0], [-1.5, 0.5, 0], [1.5, 0.5, 0]]})");
+  const std::string patch_file = quote((dir / "rectangle.json").string());
+  Result on_patch = lacuna("curve fill-rate --kind hilbert --orders 1 --width 0.5 --samples 2000 --json --surface bspline "
+                           "--patch " + patch_file, dir.path());
+  ASSERT_EQ(on_patch.code, 0) << on_patch.err;
+  const nlohmann::json bspline = nlohmann::json::parse(on_patch.out);
+  EXPECT_NEAR(bspline["area"].get<double>(), 3, 1e-5);
+  EXPECT_NEAR(bspline["fill_rate"].get<double>(), (1.625 + 3 * M_PI / 32) / 3, 1e-3);
+  EXPECT_NEAR(bspline["length"].get<double>(), 3.5, 1e-9);
+  // On a mesh patch: the square (-1, 1)^2 as 8 x 8 cells. Mean-value flattening reproduces linear maps,
+  // so the map is the identity and the rate the plane's above.
+  TriMesh square;
+  for (int j = 0; j <= 8; ++j)
+    for (int i = 0; i <= 8; ++i) square.positions_mm.push_back({-1 + 0.25 * i, -1 + 0.25 * j, 0});
+  for (uint32_t j = 0; j < 8; ++j)
+    for (uint32_t i = 0; i < 8; ++i) {
+      const uint32_t a = j * 9 + i;
+      square.triangles.push_back({a, a + 1, a + 10});
+      square.triangles.push_back({a, a + 10, a + 9});
+    }
+  write_stl((dir / "square.stl").string(), square, "square");
+  const std::string mesh_file = quote((dir / "square.stl").string());
+  Result on_mesh = lacuna("curve fill-rate --kind hilbert --orders 1 --width 0.5 --samples 2000 --json --surface mesh "
+                          "--mesh " + mesh_file, dir.path());
+  ASSERT_EQ(on_mesh.code, 0) << on_mesh.err;
+  const nlohmann::json mesh = nlohmann::json::parse(on_mesh.out);
+  EXPECT_NEAR(mesh["area"].get<double>(), 4, 1e-5);
+  EXPECT_NEAR(mesh["fill_rate"].get<double>(), round_ends / 4, 1e-3);
+  Result drawn = lacuna("curve points --kind hilbert --orders 1 --json --surface mesh --mesh " + mesh_file, dir.path());
+  ASSERT_EQ(drawn.code, 0) << drawn.err;
+  const nlohmann::json first = nlohmann::json::parse(drawn.out)["orders"][0]["points"][0];
+  EXPECT_NEAR(first[0].get<double>(), 0.5, 1e-6);
+  EXPECT_NEAR(first[1].get<double>(), 0.5, 1e-6);
+  // What is missing or wrong is named.
+  Result no_patch = lacuna("curve fill-rate --surface bspline", dir.path());
+  EXPECT_EQ(no_patch.code, 2);
+  EXPECT_NE(no_patch.err.find("--patch"), std::string::npos) << no_patch.err;
+  Result stray = lacuna("curve fill-rate --surface sphere --patch " + patch_file, dir.path());
+  EXPECT_EQ(stray.code, 2);
+  EXPECT_NE(stray.err.find("--patch"), std::string::npos) << stray.err;
+  write_file(dir / "bad_patch.json", R"({"degree_u": 1, "degree_v": 1, "count_u": 2, "count_v": 3,
+    "control_points_mm": [[-1.5, -0.5, 0], [1.5, -0.5, 0], [-1.5, 0.5, 0], [1.5, 0.5, 0]]})");
+  Result bad_patch = lacuna("curve fill-rate --surface bspline --patch " + quote((dir / "bad_patch.json").string()), dir.path());
+  EXPECT_EQ(bad_patch.code, 2);
+  EXPECT_NE(bad_patch.err.find("bad_patch.json"), std::string::npos) << bad_patch.err;
+  EXPECT_NE(bad_patch.err.find("control_points_mm"), std::string::npos) << bad_patch.err;
   Result bad = lacuna("curve fill-rate --kind peano --orders 1..3", dir.path());
   EXPECT_EQ(bad.code, 2);
   EXPECT_NE(bad.err.find("--kind"), std::string::npos) << bad.err;

@@ -11,7 +11,11 @@
 #include "cli/exit_codes.h"
 #include "cli/number_checks.h"
 #include "errors.h"
+#include "export/mesh_io.h"
 #include "pipeline/generators.h"
+#include "recipe/input_parsers.h"
+#include "recipe/json_fields.h"
+#include "solids/parameterize.h"
 
 namespace lacuna {
 namespace {
@@ -20,6 +24,8 @@ struct CurveArgs {
   std::string kind = "hilbert";
   std::string orders = "1..3";
   std::string surface = "plane";
+  std::string patch;  // --surface bspline: the patch file (JSON)
+  std::string mesh;   // --surface mesh: the disk-like mesh file
   double tolerance = 0.01;
   double width = 0.02;
   int samples = 0;
@@ -49,7 +55,26 @@ CurveSurface surface_of(const std::string& surface) {
   if (surface == "torus") return CurveSurface::kTorus;
   if (surface == "cone") return CurveSurface::kCone;
   if (surface == "cube") return CurveSurface::kCube;
-  throw InvalidInput("--surface: expected plane, sphere, cylinder, torus, cone or cube, got \"" + surface + "\"");
+  throw InvalidInput("--surface: expected plane, sphere, cylinder, torus, cone, cube, bspline or mesh, got \"" + surface +
+                     "\"");
+}
+
+bool is_patch(const CurveArgs& args) { return args.surface == "bspline" || args.surface == "mesh"; }
+
+// --surface bspline with --patch FILE (the object a curve input's "patch" is), or --surface mesh with
+// --mesh FILE (a disk-like patch, flattened onto the square as the curve input does).
+curves::SurfaceMap patch_map(const CurveArgs& args) {
+  if (args.surface == "bspline") {
+    if (args.patch.empty()) throw InvalidInput("--surface bspline: expected --patch FILE (degree_u, degree_v, count_u, count_v, control_points_mm)");
+    return curves::bspline_map(parse_bspline_patch(JsonObject(read_json_file(args.patch, "a B-spline patch (.json)"), args.patch, "patch")));
+  }
+  if (args.mesh.empty()) throw InvalidInput("--surface mesh: expected --mesh FILE (a disk-like surface patch)");
+  return mesh_patch_map(read_mesh(args.mesh), args.mesh);
+}
+
+void check_patch_options(const CurveArgs& args) {
+  if (!args.patch.empty() && args.surface != "bspline") throw InvalidInput("--patch: only read with --surface bspline");
+  if (!args.mesh.empty() && args.surface != "mesh") throw InvalidInput("--mesh: only read with --surface mesh");
 }
 
 int curve_points(const CurveArgs& args) {
@@ -57,9 +82,11 @@ int curve_points(const CurveArgs& args) {
   const bool hilbert3d = args.kind == "hilbert3d";
   if (hilbert3d && args.surface != "plane" && args.surface != "cube")
     throw InvalidInput("--surface: a 3D Hilbert curve fills the cube; it takes no surface");
+  check_patch_options(args);
   const std::vector<DrawnCurve> drawn =
-      lacuna::curve_points(hilbert3d ? curves::CurveKind::kHilbert : kind_of(args.kind), hilbert3d, orders,
-                   surface_of(args.surface), args.tolerance);
+      is_patch(args) ? lacuna::curve_points(kind_of(args.kind), orders, patch_map(args), args.tolerance)
+                     : lacuna::curve_points(hilbert3d ? curves::CurveKind::kHilbert : kind_of(args.kind), hilbert3d,
+                                            orders, surface_of(args.surface), args.tolerance);
   if (args.csv) {
     std::cout << "order,polyline,x,y,z\n";
     char line[160];
@@ -89,8 +116,13 @@ int curve_points(const CurveArgs& args) {
 // On a surface: the tubes' footprint over the surface's area (curve_surface_fill_rate).
 int curve_surface_fill_rate(const CurveArgs& args) {
   if (!(args.width > 0)) throw InvalidInput("--width: expected a positive tube diameter");
-  const SurfaceFillRate r = lacuna::curve_surface_fill_rate(kind_of(args.kind), parse_orders(args.orders), args.width,
-                                                            surface_of(args.surface), args.samples, args.tolerance);
+  check_patch_options(args);
+  const curves::CurveKind kind = kind_of(args.kind);
+  const std::vector<int> orders = parse_orders(args.orders);
+  const SurfaceFillRate r =
+      is_patch(args) ? lacuna::curve_surface_fill_rate(kind, orders, args.width, patch_map(args), args.samples, args.tolerance)
+                     : lacuna::curve_surface_fill_rate(kind, orders, args.width, surface_of(args.surface), args.samples,
+                                                       args.tolerance);
   if (args.json) {
     std::cout << nlohmann::json{{"kind", args.kind},         {"surface", args.surface},
                                 {"orders", r.orders},        {"width", args.width},
@@ -143,19 +175,25 @@ std::function<int()> add_curve_commands(CLI::App& app) {
     sub->add_option("--orders", args->orders, "FROM..TO (e.g. 1..6) or a list such as 3,4,6");
     sub->add_flag("--json", args->json, "Print JSON");
   }
-  points->add_option("--surface", args->surface, "plane, sphere, cylinder, torus, cone or cube");
+  points->add_option("--surface", args->surface, "plane, sphere, cylinder, torus, cone, cube, bspline (--patch) or mesh (--mesh)");
   points->add_option("--tolerance", args->tolerance, "Chord tolerance on a surface (units of the square)")
       ->check(positive_number());
   points->add_flag("--csv", args->csv, "Print order,polyline,x,y,z lines");
   fill->add_option("--width", args->width, "Stroke width (the square has side 2); on a surface the tubes' diameter")
       ->check(positive_number());
   fill->add_option("--surface", args->surface,
-                   "plane, sphere, cylinder, torus, cone or cube: the fraction of the (unit) surface's area the tubes\n"
-                   "along the curves drawn on it cover (without it: the square's strokes, exactly)");
+                   "plane, sphere, cylinder, torus, cone, cube, bspline (--patch) or mesh (--mesh): the fraction of\n"
+                   "the surface's area the tubes along the curves drawn on it cover (without it: the square's\n"
+                   "strokes, exactly)");
   fill->add_option("--samples", args->samples, "On a surface: integration cells per side (default: 8 across a tube)")
       ->check(CLI::Range(16, 20000));
   fill->add_option("--tolerance", args->tolerance, "On a surface: chord tolerance of the drawn curves")
       ->check(positive_number());
+  for (CLI::App* sub : {points, fill}) {
+    sub->add_option("--patch", args->patch,
+                    "With --surface bspline: a JSON file {degree_u, degree_v, count_u, count_v, control_points_mm (u fastest)}");
+    sub->add_option("--mesh", args->mesh, "With --surface mesh: a disk-like surface patch (.stl, .obj, .ply, .3mf or .drc)");
+  }
   return [=]() -> int {
     if (*points) return curve_points(*args);
     if (*fill) {

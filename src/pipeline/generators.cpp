@@ -12,6 +12,7 @@
 
 #include "cifs/nurbs.h"
 #include "cifs/tessellate.h"
+#include "curves/sweep.h"
 #include "errors.h"
 #include "recipe/cifs_system.h"
 
@@ -114,57 +115,70 @@ NurbsCurvePoints nurbs_curve_points(int degree, const std::vector<double>& knots
   return out;
 }
 
-std::vector<DrawnCurve> curve_points(curves::CurveKind kind, bool hilbert3d, const std::vector<int>& orders,
-                                     CurveSurface surface, double tolerance) {
+namespace {
+
+// The drawn polylines, refusing more than 20 000 000 points in all.
+struct Drawing {
   std::vector<DrawnCurve> drawn;
   uint64_t total = 0;
-  auto keep = [&](int order, std::vector<Vec3d> points, bool closed) {
+  void keep(int order, std::vector<Vec3d> points, bool closed) {
     total += points.size();
     if (total > 20'000'000) throw ResourceLimit("more than 20 000 000 points; ask for lower orders");
     drawn.push_back(DrawnCurve{order, closed, std::move(points)});
-  };
+  }
+};
+
+void draw_on_map(Drawing& drawing, curves::CurveKind kind, const std::vector<int>& orders,
+                 const curves::SurfaceMap& map, double tolerance) {
+  curves::MapOptions options;
+  options.tolerance_mm = tolerance;
+  for (const curves::Curve2& c : curves::superposition(kind, orders)) {
+    curves::Polyline3 line = curves::map_polyline(c.polyline, map, options);
+    drawing.keep(c.order, std::move(line.points), line.closed);
+  }
+}
+
+}  // namespace
+
+std::vector<DrawnCurve> curve_points(curves::CurveKind kind, bool hilbert3d, const std::vector<int>& orders,
+                                     CurveSurface surface, double tolerance) {
+  Drawing drawing;
   if (hilbert3d) {
     if (surface != CurveSurface::kPlane && surface != CurveSurface::kCube)
       throw InvalidInput("a 3D Hilbert curve fills the cube; it takes no surface");
-    for (const curves::Curve3& c : curves::superposition3d(orders)) keep(c.order, c.polyline.points, c.polyline.closed);
-    return drawn;
+    for (const curves::Curve3& c : curves::superposition3d(orders))
+      drawing.keep(c.order, c.polyline.points, c.polyline.closed);
+    return std::move(drawing.drawn);
   }
-  curves::MapOptions options;
-  options.tolerance_mm = tolerance;
-  if (surface == CurveSurface::kCube) {
-    for (int order : orders)
-      for (const curves::Polyline3& line : curves::cube_curve(kind, order, options))
-        keep(order, line.points, line.closed);
-    return drawn;
-  }
-  curves::SurfaceMap map;
   switch (surface) {
-    case CurveSurface::kSphere:
-      map = curves::sphere_map();
+    case CurveSurface::kPlane:
+      for (const curves::Curve2& c : curves::superposition(kind, orders)) {
+        std::vector<Vec3d> points;
+        for (const Vec2d& p : c.polyline.points) points.push_back(Vec3d{p.x, p.y, 0});
+        drawing.keep(c.order, std::move(points), c.polyline.closed);
+      }
       break;
-    case CurveSurface::kCylinder:
-      map = curves::cylinder_map();
+    case CurveSurface::kCube: {
+      curves::MapOptions options;
+      options.tolerance_mm = tolerance;
+      for (int order : orders)
+        for (const curves::Polyline3& line : curves::cube_curve(kind, order, options))
+          drawing.keep(order, line.points, line.closed);
       break;
-    case CurveSurface::kTorus:
-      map = curves::torus_map();
-      break;
-    case CurveSurface::kCone:
-      map = curves::cone_map();
-      break;
-    default:
-      break;
-  }
-  for (const curves::Curve2& c : curves::superposition(kind, orders)) {
-    if (surface == CurveSurface::kPlane) {
-      std::vector<Vec3d> points;
-      for (const Vec2d& p : c.polyline.points) points.push_back(Vec3d{p.x, p.y, 0});
-      keep(c.order, std::move(points), c.polyline.closed);
-    } else {
-      curves::Polyline3 line = curves::map_polyline(c.polyline, map, options);
-      keep(c.order, line.points, line.closed);
     }
+    case CurveSurface::kSphere: draw_on_map(drawing, kind, orders, curves::sphere_map(), tolerance); break;
+    case CurveSurface::kCylinder: draw_on_map(drawing, kind, orders, curves::cylinder_map(), tolerance); break;
+    case CurveSurface::kTorus: draw_on_map(drawing, kind, orders, curves::torus_map(), tolerance); break;
+    case CurveSurface::kCone: draw_on_map(drawing, kind, orders, curves::cone_map(), tolerance); break;
   }
-  return drawn;
+  return std::move(drawing.drawn);
+}
+
+std::vector<DrawnCurve> curve_points(curves::CurveKind kind, const std::vector<int>& orders,
+                                     const curves::SurfaceMap& surface, double tolerance) {
+  Drawing drawing;
+  draw_on_map(drawing, kind, orders, surface, tolerance);
+  return std::move(drawing.drawn);
 }
 
 CurveFillRate curve_fill_rate(curves::CurveKind kind, const std::vector<int>& orders, double width) {
@@ -186,39 +200,23 @@ CurveFillRate curve_fill_rate(curves::CurveKind kind, const std::vector<int>& or
   return r;
 }
 
-SurfaceFillRate curve_surface_fill_rate(curves::CurveKind kind, const std::vector<int>& orders, double width,
-                                        CurveSurface surface, int samples, double tolerance) {
-  if (!(width > 0) || !std::isfinite(width)) throw InvalidInput("expected a positive tube width");
-  if (samples != 0 && (samples < 16 || samples > 20000))
-    throw InvalidInput("samples: expected 16 .. 20000 per side, or 0 for eight cells across a tube");
+namespace {
+
+// The footprint of tubes of diameter `width` along the drawn curves on the surface the maps make up
+// (the cube: one per face), integrated over samples x samples cells of each map's square.
+SurfaceFillRate surface_fill_rate(const std::vector<DrawnCurve>& drawn, const std::vector<curves::SurfaceMap>& maps,
+                                  double width, int samples) {
   const int n = samples ? samples : int(std::clamp(std::ceil(16 / width), 256.0, 20000.0));
   SurfaceFillRate r;
   r.samples = n;
   std::vector<curves::Polyline3> lines;
-  for (const DrawnCurve& c : curve_points(kind, false, orders, surface, tolerance)) {
+  for (const DrawnCurve& c : drawn) {
     if (r.orders.empty() || r.orders.back() != c.order) r.orders.push_back(c.order);
     for (size_t i = 0; i + 1 < c.points.size() + (c.closed ? 1 : 0); ++i)
       r.length += norm(c.points[(i + 1) % c.points.size()] - c.points[i]);
     lines.push_back(curves::Polyline3{c.points, c.closed});
   }
   const curves::TubeFootprint footprint(lines, width / 2);
-  std::vector<curves::SurfaceMap> maps;
-  switch (surface) {
-    case CurveSurface::kPlane: {
-      curves::SurfaceMap plane;
-      plane.name = "plane";
-      plane.point = [](double X, double Y) { return Vec3d{X, Y, 0}; };
-      maps.push_back(plane);
-      break;
-    }
-    case CurveSurface::kSphere: maps.push_back(curves::sphere_map()); break;
-    case CurveSurface::kCylinder: maps.push_back(curves::cylinder_map()); break;
-    case CurveSurface::kTorus: maps.push_back(curves::torus_map()); break;
-    case CurveSurface::kCone: maps.push_back(curves::cone_map()); break;
-    case CurveSurface::kCube:
-      for (int face = 0; face < 6; ++face) maps.push_back(curves::cube_face_map(face));
-      break;
-  }
   for (const curves::SurfaceMap& map : maps) {
     std::vector<curves::SurfaceCoverage> rows(static_cast<size_t>(n));
     tbb::parallel_for(0, n, [&](int j) { rows[size_t(j)] = curves::surface_coverage(map, footprint, n, j, j + 1); });
@@ -227,6 +225,37 @@ SurfaceFillRate curve_surface_fill_rate(curves::CurveKind kind, const std::vecto
   r.fill_rate = r.area > 0 ? r.covered_area / r.area : 0;
   r.fill_rate_simple = r.area > 0 ? r.length * width / r.area : 0;
   return r;
+}
+
+void check_fill_rate_options(double width, int samples) {
+  if (!(width > 0) || !std::isfinite(width)) throw InvalidInput("expected a positive tube width");
+  if (samples != 0 && (samples < 16 || samples > 20000))
+    throw InvalidInput("samples: expected 16 .. 20000 per side, or 0 for eight cells across a tube");
+}
+
+}  // namespace
+
+SurfaceFillRate curve_surface_fill_rate(curves::CurveKind kind, const std::vector<int>& orders, double width,
+                                        CurveSurface surface, int samples, double tolerance) {
+  check_fill_rate_options(width, samples);
+  std::vector<curves::SurfaceMap> maps;
+  switch (surface) {
+    case CurveSurface::kPlane: maps.push_back(curves::plane_map()); break;
+    case CurveSurface::kSphere: maps.push_back(curves::sphere_map()); break;
+    case CurveSurface::kCylinder: maps.push_back(curves::cylinder_map()); break;
+    case CurveSurface::kTorus: maps.push_back(curves::torus_map()); break;
+    case CurveSurface::kCone: maps.push_back(curves::cone_map()); break;
+    case CurveSurface::kCube:
+      for (int face = 0; face < 6; ++face) maps.push_back(curves::cube_face_map(face));
+      break;
+  }
+  return surface_fill_rate(curve_points(kind, false, orders, surface, tolerance), maps, width, samples);
+}
+
+SurfaceFillRate curve_surface_fill_rate(curves::CurveKind kind, const std::vector<int>& orders, double width,
+                                        const curves::SurfaceMap& surface, int samples, double tolerance) {
+  check_fill_rate_options(width, samples);
+  return surface_fill_rate(curve_points(kind, orders, surface, tolerance), {surface}, width, samples);
 }
 
 VoronoiCells voronoi_cells(const voronoi::Rules& rules, int level, bool scaled_children) {

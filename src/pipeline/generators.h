@@ -70,6 +70,10 @@ struct DrawnCurve {
 // surface, ResourceLimit beyond 20 000 000 points.
 std::vector<DrawnCurve> curve_points(curves::CurveKind kind, bool hilbert3d, const std::vector<int>& orders,
                                      CurveSurface surface, double tolerance);
+// The same on a surface the caller gives as a map of the square (a B-spline patch from
+// curves::bspline_map, a mesh patch from mesh_patch_map): the 2D curves only.
+std::vector<DrawnCurve> curve_points(curves::CurveKind kind, const std::vector<int>& orders,
+                                     const curves::SurfaceMap& surface, double tolerance);
 
 // The fraction of the square (-1, 1)^2 the strokes of width `width` along the curves cover.
 struct CurveFillRate {
@@ -100,6 +104,10 @@ struct SurfaceFillRate {
 // Throws InvalidInput unless width > 0 and samples is 0 or 16 .. 20000, and as curve_points().
 SurfaceFillRate curve_surface_fill_rate(curves::CurveKind kind, const std::vector<int>& orders, double width,
                                         CurveSurface surface, int samples, double tolerance);
+// The same on a surface the caller gives as a map of the square (a B-spline or mesh patch): its area
+// and the footprint integrated over the square as for the built-in surfaces.
+SurfaceFillRate curve_surface_fill_rate(curves::CurveKind kind, const std::vector<int>& orders, double width,
+                                        const curves::SurfaceMap& surface, int samples, double tolerance);
 
 // A fractal Voronoi level's cell measures per colour and, with scaled children, its walls.
 struct VoronoiCells {

@@ -15,8 +15,12 @@
 #include "pipeline/build_inputs.h"
 #include "python/convert.h"
 #include "python/objects.h"
+#include "export/mesh_io.h"
 #include "recipe/cifs_system.h"
+#include "recipe/input_parsers.h"
+#include "recipe/json_fields.h"
 #include "recipe/recipe.h"
+#include "solids/parameterize.h"
 
 namespace lacuna {
 namespace python {
@@ -319,6 +323,57 @@ void add_generators(py::module_& m) {
       py::arg("kind") = "hilbert", py::arg("orders") = "1..3", py::arg("width") = 0.02,
       "The fraction of the square (-1, 1)^2 covered by strokes of `width` (units of the square, side 2) along the "
       "curves: exactly (fill_rate, the union of the strokes) and simply (fill_rate_simple, length x width / 4).");
+  m.def(
+      "curve_surface_fill_rate",
+      [](const std::string& kind, const py::handle& orders, double width, const std::string& surface,
+         const py::object& patch, const py::object& mesh, int samples, double tolerance) {
+        const std::vector<int> o = orders_of(orders);
+        const curves::CurveKind k = kind_of(kind);
+        if (!(tolerance > 0)) throw InvalidInput("tolerance: expected a positive chord tolerance");
+        if (!patch.is_none() && surface != "bspline") throw InvalidInput("patch: only read with surface=\"bspline\"");
+        if (!mesh.is_none() && surface != "mesh") throw InvalidInput("mesh: only read with surface=\"mesh\"");
+        SurfaceFillRate r;
+        if (surface == "bspline" || surface == "mesh") {
+          curves::SurfaceMap map;
+          if (surface == "bspline") {
+            if (patch.is_none()) throw InvalidInput("patch: expected {degree_u, degree_v, count_u, count_v, control_points_mm}");
+            map = curves::bspline_map(parse_bspline_patch(JsonObject(to_json(patch, "patch"), "patch", "patch")));
+          } else if (py::isinstance<Mesh>(mesh)) {
+            map = mesh_patch_map(*mesh.cast<const Mesh&>().data, mesh.cast<const Mesh&>().label);
+          } else {
+            if (mesh.is_none()) throw InvalidInput("mesh: expected a disk-like surface patch (a lacuna.Mesh or a file)");
+            const std::string file = path_of(mesh);
+            map = released([&] { return mesh_patch_map(read_mesh(file), file); });
+          }
+          r = about("surface", [&] {
+            return released([&] { return curve_surface_fill_rate(k, o, width, map, samples, tolerance); });
+          });
+        } else {
+          const CurveSurface s = surface_of(surface);
+          r = about("surface", [&] {
+            return released([&] { return curve_surface_fill_rate(k, o, width, s, samples, tolerance); });
+          });
+        }
+        py::dict d;
+        d["kind"] = kind;
+        d["surface"] = surface;
+        d["orders"] = r.orders;
+        d["width"] = width;
+        d["samples"] = r.samples;
+        d["area"] = r.area;
+        d["covered_area"] = r.covered_area;
+        d["length"] = r.length;
+        d["fill_rate"] = r.fill_rate;
+        d["fill_rate_simple"] = r.fill_rate_simple;
+        return d;
+      },
+      py::arg("kind") = "hilbert", py::arg("orders") = "1..3", py::arg("width") = 0.02, py::arg("surface") = "plane",
+      py::arg("patch") = py::none(), py::arg("mesh") = py::none(), py::arg("samples") = 0, py::arg("tolerance") = 0.01,
+      "The fraction of a surface's area that tubes of diameter `width` along the curves drawn on it cover (as "
+      "`lacuna curve fill-rate --surface`): plane, sphere, cylinder, torus, cone, cube, bspline (`patch`: a dict "
+      "{degree_u, degree_v, count_u, count_v, control_points_mm}) or mesh (`mesh`: a disk-like lacuna.Mesh or "
+      "file). samples: integration cells per side (0: eight across a tube). area, covered_area, length, "
+      "fill_rate, fill_rate_simple.");
   m.def(
       "fill_pattern",
       [](const std::string& group, const py::handle& lattice, double c, double N, const py::handle& motif, size_t count,

@@ -35,6 +35,10 @@ BcifsInfillInput parse_bcifs_infill_input(const JsonObject& o);
 // "origin_mm". Also read by `lacuna bcifs measure`, which takes the objects of a recipe as they are.
 BcifsPlateInput parse_bcifs_plate_input(const JsonObject& o);
 
+// A tensor-product B-spline patch {degree_u, degree_v, count_u, count_v, control_points_mm (u fastest)}: a
+// curve input's "patch", and the file `lacuna curve points|fill-rate --surface bspline --patch` reads.
+curves::BSplinePatch parse_bspline_patch(const JsonObject& p);
+
 // A grade's field: "field" ramp {axis, from_mm, to_mm}, points {points_mm, falloff_mm} or depth {depth_mm}. A depth
 // field is refused with `no_depth` as the message unless that is empty (the input has a hull to measure it in).
 GradeField parse_grade_field(const JsonObject& g, const std::string& no_depth);

@@ -10,7 +10,6 @@
 namespace lacuna {
 namespace {
 
-using curves::BSplinePatch;
 using curves::SweepOptions;
 
 // "orders": [1, 2, 5] or "1..5".
@@ -44,9 +43,11 @@ std::vector<int> parse_orders(const JsonObject& o, int most) {
   return orders;
 }
 
-BSplinePatch parse_patch(const JsonObject& p) {
+}  // namespace
+
+curves::BSplinePatch parse_bspline_patch(const JsonObject& p) {
   p.allow_only({"degree_u", "degree_v", "count_u", "count_v", "control_points_mm"});
-  BSplinePatch patch;
+  curves::BSplinePatch patch;
   patch.degree_u = int(p.unsigned_integer_or("degree_u", 3));
   patch.degree_v = int(p.unsigned_integer_or("degree_v", 3));
   patch.count_u = int(p.unsigned_integer_or("count_u", 0));
@@ -60,8 +61,6 @@ BSplinePatch parse_patch(const JsonObject& p) {
                                     " points (u fastest), got " + std::to_string(patch.control_points.size()));
   return patch;
 }
-
-}  // namespace
 
 GradeField parse_grade_field(const JsonObject& g, const std::string& no_depth) {
   GradeField f;
@@ -202,7 +201,7 @@ CurveInput parse_curve_input(const JsonObject& o) {
   else if (surface == "cube") in.surface = Surface::kCube;
   else if (surface == "bspline") {
     in.surface = Surface::kBspline;
-    in.patch = parse_patch(o.object("patch"));
+    in.patch = parse_bspline_patch(o.object("patch"));
   } else if (!mesh) {
     o.fail("surface", "expected \"plane\", \"sphere\", \"cylinder\", \"torus\", \"cone\", \"cube\", \"bspline\" or \"mesh\", got \"" + surface + "\"");
   }

@@ -81,6 +81,39 @@ def test_fill_rate_of_hilbert_order_one_by_hand():
     assert f["segments"] == 3 and f["length"] == pytest.approx(3.0)
 
 
+def test_surface_fill_rate_on_patches_by_hand():
+    # H_1 as round-ended tubes of diameter 0.5. On the plane: 3 x 0.5 less the bends' inner squares,
+    # plus their outer quarter disks and the two end half disks, of the square's 4.
+    round_ends = 3 * 0.5 - 2 * 0.0625 + 2 * math.pi * 0.0625 / 4 + math.pi * 0.0625
+    plane = lacuna.curve_surface_fill_rate(kind="hilbert", orders=[1], width=0.5, samples=2000)
+    assert plane["area"] == pytest.approx(4, abs=1e-9)
+    assert plane["fill_rate"] == pytest.approx(round_ends / 4, abs=1e-3)
+    # The flat 3 x 1 rectangle as a bilinear B-spline patch: the cell centres go to (+-0.75, +-0.25);
+    # the middle 1.5 x 1, two half disks on the right, a 0.25 x 0.5 strip and two quarter disks on the left.
+    patch = {"degree_u": 1, "degree_v": 1, "count_u": 2, "count_v": 2,
+             "control_points_mm": [[-1.5, -0.5, 0], [1.5, -0.5, 0], [-1.5, 0.5, 0], [1.5, 0.5, 0]]}
+    r = lacuna.curve_surface_fill_rate(kind="hilbert", orders=[1], width=0.5, surface="bspline", patch=patch,
+                                       samples=2000)
+    assert r["area"] == pytest.approx(3, abs=1e-5)
+    assert r["fill_rate"] == pytest.approx((1.625 + 3 * math.pi / 32) / 3, abs=1e-3)
+    # The square as an 8 x 8 mesh: mean-value flattening reproduces linear maps, so the plane's rate.
+    g = np.linspace(-1, 1, 9)
+    v = np.array([[x, y, 0.0] for y in g for x in g])
+    f = []
+    for j in range(8):
+        for i in range(8):
+            a = j * 9 + i
+            f += [[a, a + 1, a + 10], [a, a + 10, a + 9]]
+    m = lacuna.curve_surface_fill_rate(kind="hilbert", orders=[1], width=0.5, surface="mesh",
+                                       mesh=lacuna.Mesh(v, np.array(f)), samples=2000)
+    assert m["area"] == pytest.approx(4, abs=1e-5)
+    assert m["fill_rate"] == pytest.approx(plane["fill_rate"], abs=1e-5)
+    with pytest.raises(lacuna.InvalidInputError, match="patch"):
+        lacuna.curve_surface_fill_rate(surface="bspline")
+    with pytest.raises(lacuna.InvalidInputError, match="control_points_mm"):
+        lacuna.curve_surface_fill_rate(surface="bspline", patch=dict(patch, count_v=3))
+
+
 def test_fill_pattern_follows_the_area_law():
     c, N = 1.3, 2.0
     r = lacuna.fill_pattern(group="p1", lattice=[[10, 0], [0, 10]], c=c, N=N, count=40, seed=5)

@@ -467,6 +467,16 @@ def curve_points(
 def curve_fill_rate(
     kind: str = "hilbert", orders: Union[str, Sequence[int]] = "1..3", width: float = 0.02
 ) -> Dict[str, Any]: ...
+def curve_surface_fill_rate(
+    kind: str = "hilbert",
+    orders: Union[str, Sequence[int]] = "1..3",
+    width: float = 0.02,
+    surface: str = "plane",
+    patch: Optional[Dict[str, Any]] = None,
+    mesh: Union[None, Mesh, str, os.PathLike] = None,
+    samples: int = 0,
+    tolerance: float = 0.01,
+) -> Dict[str, Any]: ...
 def fill_pattern(
     group: str = "p1",
     lattice: npt.ArrayLike = ((10.0, 0.0), (0.0, 10.0)),
