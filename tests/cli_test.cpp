@@ -15,6 +15,7 @@
 #include "export/mesh_io.h"
 #include "fill/fill.h"
 #include "tests/test_support.h"
+#include <map>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -497,6 +498,8 @@ std::vector<BadCase> bad_cases() {
       {"fill_motifs_bad_c", with_input(R"({"type": "fill_motifs", "motif": "circle", "height_mm": 1, "c": 0.9, "region": {"disk": {"radius_mm": 5}}})"), "", "", "inputs.x.c"},
       {"fill_motifs_wrap_slanted", with_input(R"({"type": "fill_motifs", "motif": "circle", "height_mm": 1, "wallpaper": {"group": "p1", "a_mm": [10, 3], "b_mm": [0, 10], "cells": [2, 1]}, "wrap": {"depth_mm": 2}})"), "", "", "lie along x"},
       {"fill_motifs_bad_polygon", with_input(R"({"type": "fill_motifs", "motif": {"polygon": [[0, 0], [1, 1], [1, 0], [0, 1]]}, "height_mm": 1, "region": {"disk": {"radius_mm": 5}}})"), "", "", "inputs.x.motif"},
+      {"fill_motifs_missing_file", with_input(R"({"type": "fill_motifs", "motif": {"file": "nowhere.svg"}, "height_mm": 1, "region": {"disk": {"radius_mm": 5}}})"), "", "", "nowhere.svg"},
+      {"fill_motifs_file_kind", with_input(R"({"type": "fill_motifs", "motif": {"file": "motif.png"}, "height_mm": 1, "region": {"disk": {"radius_mm": 5}}})"), "", "", "inputs.x.motif"},
       {"fill_spheres_two_regions", with_input(R"({"type": "fill_spheres", "box": {"min_mm": [0,0,0], "max_mm": [5,5,5]}, "sphere": {"radius_mm": 3}})"), "", "", "one region"},
       {"fill_spheres_bad_motif", with_input(R"({"type": "fill_spheres", "motif": "dodecahedron", "sphere": {"radius_mm": 3}})"), "", "", "inputs.x.motif"},
       {"bcifs_infill_grade_levels", R"({"inputs": {"h": {"type": "sphere", "radius_mm": 8}, "x": {"type": "bcifs_infill",
@@ -644,6 +647,55 @@ TEST(Cli, FillPatternJsonSvgAndDeterminism) {
   Result bad_lattice = lacuna("fill pattern --group p4 --lattice " + quote("10,0;0,7"), dir.path());
   EXPECT_EQ(bad_lattice.code, 2);
   EXPECT_NE(bad_lattice.err.find("p4"), std::string::npos) << bad_lattice.err;
+}
+
+TEST(Cli, FillPatternMotifFilesAndColours) {
+  TempDir dir;
+  // An L-shaped hexagon (no symmetry) as an SVG path with relative and axis-parallel segments, coloured by
+  // size class: motif i's class is floor(c log2((N + i) / N)) (areas follow the rule, no snapping here).
+  write_file(dir / "ell.svg", R"(<svg xmlns="http://www.w3.org/2000/svg"><path fill="black" d="M0,0 h2 v1 h-1 v1 H0 Z"/></svg>)");
+  const std::string svg = quote((dir / "colours.svg").string());
+  Result r = lacuna("fill pattern --group p2 --motif " + quote((dir / "ell.svg").string()) +
+                        " --count 40 --seed 3 --colors size --palette " + quote("#000001,#000002,#000003,#000004,#000005") +
+                        " --json --svg " + svg,
+                    dir.path());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  ASSERT_GT(j["motifs"].size(), 10u);
+  std::map<std::string, size_t> per_colour;
+  for (size_t i = 0; i < j["motifs"].size(); ++i) {
+    const int k = int(std::floor(1.3 * std::log2((2.0 + double(i)) / 2.0) + 1e-12));
+    const std::string colour = "#00000" + std::to_string(k % 5 + 1);
+    EXPECT_EQ(j["motifs"][i]["color"], colour) << i;
+    ++per_colour[colour];
+  }
+  // p2 has two operations: every motif appears twice per cell, 3 x 3 cells, in its motif's colour.
+  const std::string picture = read_file(dir / "colours.svg");
+  for (const auto& [colour, motifs] : per_colour) {
+    size_t drawn = 0;
+    for (size_t at = picture.find("fill=\"" + colour + "\""); at != std::string::npos; at = picture.find("fill=\"" + colour + "\"", at + 1)) ++drawn;
+    EXPECT_EQ(drawn, motifs * 2 * 9) << colour;
+  }
+  // A JSON list of points works the same; without --colors the motifs are black and carry no colour.
+  write_file(dir / "ell.json", "[[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]]");
+  Result svg_run = lacuna("fill pattern --group p2 --motif " + quote((dir / "ell.svg").string()) + " --count 40 --seed 3 --json", dir.path());
+  Result json_run = lacuna("fill pattern --group p2 --motif " + quote((dir / "ell.json").string()) + " --count 40 --seed 3 --json", dir.path());
+  ASSERT_EQ(json_run.code, 0) << json_run.err;
+  const nlohmann::json a = nlohmann::json::parse(svg_run.out), b = nlohmann::json::parse(json_run.out);
+  EXPECT_EQ(a["motifs"].size(), b["motifs"].size());
+  EXPECT_FALSE(b["motifs"][0].contains("color"));
+  // What is wrong is named.
+  write_file(dir / "curve.svg", R"(<svg><path d="M0 0 Q1 1 2 0 Z"/></svg>)");
+  Result curve = lacuna("fill pattern --motif " + quote((dir / "curve.svg").string()), dir.path());
+  EXPECT_EQ(curve.code, 2);
+  EXPECT_NE(curve.err.find("curve.svg"), std::string::npos) << curve.err;
+  EXPECT_NE(curve.err.find("straight segments"), std::string::npos) << curve.err;
+  Result colours = lacuna("fill pattern --colors rainbow", dir.path());
+  EXPECT_EQ(colours.code, 2);
+  EXPECT_NE(colours.err.find("--colors"), std::string::npos) << colours.err;
+  Result palette = lacuna("fill pattern --colors orbit --palette " + quote("#12345"), dir.path());
+  EXPECT_EQ(palette.code, 2);
+  EXPECT_NE(palette.err.find("--palette"), std::string::npos) << palette.err;
 }
 
 TEST(Cli, VoronoiRulesAndCells) {

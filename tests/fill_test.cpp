@@ -12,7 +12,9 @@
 #include <vector>
 
 #include "errors.h"
+#include "fill/motif_file.h"
 #include "fill/wallpaper.h"
+#include "tests/test_support.h"
 
 namespace lacuna {
 namespace {
@@ -732,6 +734,108 @@ TEST(Fill, UncoveredSetHasDimensionTwoOverC) {
     EXPECT_GT(boxes.boxes[i], boxes.boxes[i - 1]);
     EXPECT_LE(boxes.boxes[i], 4 * boxes.boxes[i - 1]);
   }
+}
+
+TEST(Fill, SvgPathsOfStraightSegments) {
+  // Absolute and relative moves and lines, horizontal and vertical lines, implicit line-tos, exponents.
+  const std::vector<Vec2d> p = fill::svg_path_points("M1,2 L3 2 h2 v1e0 l-1,1 H0.5 V 3 z", "square.svg");
+  const std::vector<Vec2d> expected{{1, 2}, {3, 2}, {5, 2}, {5, 3}, {4, 4}, {0.5, 4}, {0.5, 3}};
+  ASSERT_EQ(p.size(), expected.size());
+  for (size_t i = 0; i < p.size(); ++i) EXPECT_TRUE(p[i].x == expected[i].x && p[i].y == expected[i].y) << i;
+  const std::vector<Vec2d> q = fill::svg_path_points("m 1 1 2 0 0 2 -2 0 Z", "q");
+  ASSERT_EQ(q.size(), 4u);
+  EXPECT_TRUE(q[2].x == 3 && q[2].y == 3);
+  // A closing point equal to the first is the same corner.
+  EXPECT_EQ(fill::svg_path_points("M0 0 L1 0 L0 1 L0 0 Z", "t").size(), 3u);
+  for (const char* bad : {"M0 0 C1 1 2 2 3 3 Z", "M0 0 L1 0 L0 1 Z M5 5 L6 5 L5 6 Z", "L1 0 2 2", "M0 0 L1 x", "", "M0 0 A 1 1 0 0 1 2 2"})
+    EXPECT_THROW(fill::svg_path_points(bad, "bad.svg"), InvalidInput) << bad;
+  try {
+    fill::svg_path_points("M0 0 Q1 1 2 0 Z", "curvy.svg");
+    FAIL();
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("curvy.svg"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("'Q'"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Fill, MotifFilesKeepTheirSymmetry) {
+  // A regular five-pointed star written to 17 digits: rotation order 5 and five mirrors, from an SVG path
+  // (y down, so the star is flipped, which keeps its symmetry) and from a JSON list.
+  test::TempDir dir;
+  std::string d = "M", json = "[";
+  char buf[96];
+  for (int k = 0; k < 10; ++k) {
+    const double r = k % 2 ? 0.4 : 1, a = kPi / 2 + k * kPi / 5;
+    std::snprintf(buf, sizeof buf, "%s%.17g,%.17g", k ? " " : "", r * std::cos(a), r * std::sin(a));
+    d += buf;
+    std::snprintf(buf, sizeof buf, "%s[%.17g, %.17g]", k ? ", " : "", r * std::cos(a), r * std::sin(a));
+    json += buf;
+  }
+  test::write_file(dir / "star.svg", "<?xml version=\"1.0\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\">\n  <path id=\"star\" d=\"" + d + " Z\"/>\n</svg>\n");
+  test::write_file(dir / "star.json", json + "]");
+  test::write_file(dir / "star_object.json", "{\"polygon\": " + json + "]}");
+  for (const char* name : {"star.svg", "star.json", "star_object.json"}) {
+    const std::vector<Vec2d> outline = fill::read_motif_outline((dir / name).string());
+    ASSERT_EQ(outline.size(), 10u) << name;
+    const Motif2 m = fill::polygon_motif(outline);
+    EXPECT_EQ(m.rotation_order, 5) << name;
+    EXPECT_EQ(m.mirror_angles_rad.size(), 5u) << name;
+    EXPECT_FALSE(m.convex) << name;
+  }
+  // SVG's y axis points down: the first point (0, 1) reads as (0, -1).
+  EXPECT_NEAR(fill::read_motif_outline((dir / "star.svg").string())[0].y, -1, 1e-15);
+  test::write_file(dir / "flat.svg", "<svg><path d=\"M0 0 C1 1 2 2 0 1 Z\"/></svg>");
+  test::write_file(dir / "none.svg", "<svg><rect width=\"1\" height=\"1\"/></svg>");
+  test::write_file(dir / "bad.json", "[[0, 0], [1, 0], [1]]");
+  for (const char* name : {"flat.svg", "none.svg", "bad.json", "motif.png"})
+    EXPECT_THROW(fill::read_motif_outline((dir / name).string()), InvalidInput) << name;
+  EXPECT_THROW(fill::read_motif_outline((dir / "missing.svg").string()), IoError);
+}
+
+TEST(Fill, MotifColoursBySizeOrbitAndChance) {
+  // p1 circles without snapping: motif i has area A / (zeta(c, N) (N + i)^c), so its size class (octaves
+  // below the first motif's area) is floor(c log2((N + i) / N)).
+  fill::FillOptions o;
+  o.c = 1.3;
+  o.N = 2;
+  o.max_count = 60;
+  o.seed = 5;
+  const fill::WallpaperFill f = fill::fill_wallpaper(fill::Group::p4, {{10, 0}, {0, 10}}, fill::circle_motif(), o);
+  const std::vector<Placement2>& motifs = f.fundamental.motifs;
+  ASSERT_GT(motifs.size(), 20u);
+  const std::vector<int> size = fill::motif_colors(f.fundamental, fill::Coloring::kSize, 64, 1);
+  for (size_t i = 0; i < motifs.size(); ++i)
+    EXPECT_EQ(size[i], int(std::floor(o.c * std::log2((o.N + double(i)) / o.N) + 1e-12))) << i;
+  const std::vector<int> size3 = fill::motif_colors(f.fundamental, fill::Coloring::kSize, 3, 1);
+  for (size_t i = 0; i < motifs.size(); ++i) EXPECT_EQ(size3[i], size[i] % 3) << i;
+  const std::vector<int> orbit = fill::motif_colors(f.fundamental, fill::Coloring::kOrbit, 4, 1);
+  for (size_t i = 0; i < motifs.size(); ++i) EXPECT_EQ(orbit[i], int(i % 4)) << i;
+  const std::vector<int> random = fill::motif_colors(f.fundamental, fill::Coloring::kRandom, 4, 9);
+  EXPECT_EQ(random, fill::motif_colors(f.fundamental, fill::Coloring::kRandom, 4, 9));
+  std::set<int> used(random.begin(), random.end());
+  EXPECT_EQ(used, (std::set<int>{0, 1, 2, 3}));  // 4 colours over more than 20 motifs
+  EXPECT_THROW(fill::motif_colors(f.fundamental, fill::Coloring::kOrbit, 0, 1), InvalidInput);
+  // The picture: every image of a motif in its motif's colour, |p4| = 4 images per motif and cell.
+  const std::vector<std::string> palette{"#000001", "#000002", "#000003", "#000004"};
+  std::vector<std::string> fills;
+  for (int c : orbit) fills.push_back(palette[size_t(c)]);
+  const std::string svg = fill::wallpaper_svg(f, 2, fills);
+  std::vector<uint32_t> orbits;
+  const std::vector<Placement2> all = fill::replicate(f, 2, 2, &orbits);
+  ASSERT_EQ(orbits.size(), all.size());
+  EXPECT_EQ(all.size(), motifs.size() * 4 * 4);
+  for (int c = 0; c < 4; ++c) {
+    size_t drawn = 0, expected = 0;
+    const std::string tag = "fill=\"" + palette[size_t(c)] + "\"";
+    for (size_t at = svg.find(tag); at != std::string::npos; at = svg.find(tag, at + 1)) ++drawn;
+    for (uint32_t m : orbits) expected += orbit[m] == c;
+    EXPECT_EQ(drawn, expected) << c;
+    EXPECT_GT(drawn, 0u);
+  }
+  EXPECT_THROW(fill::wallpaper_svg(f, 2, {"#000000"}), InvalidInput);
+  EXPECT_EQ(fill::parse_palette(" #1B9E77, #d95f02"), (std::vector<std::string>{"#1b9e77", "#d95f02"}));
+  for (const char* bad : {"", "#12345", "#12345g", "1b9e77", "#1b9e77,,#d95f02"})
+    EXPECT_THROW(fill::parse_palette(bad), InvalidInput) << bad;
 }
 
 }  // namespace

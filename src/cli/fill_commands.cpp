@@ -13,6 +13,7 @@
 #include "cli/number_checks.h"
 #include "errors.h"
 #include "fill/fill.h"
+#include "fill/motif_file.h"
 #include "fill/wallpaper.h"
 
 namespace lacuna {
@@ -31,6 +32,8 @@ struct FillArgs {
   std::string policy = "reject";
   bool random_rotation = false;
   std::string svg;
+  std::string colors;   // size, orbit or random; empty: black
+  std::string palette;  // "#rrggbb,..."; empty: the default
   int cells = 3;
   bool json = false;
 };
@@ -61,7 +64,16 @@ fill::Motif2 motif_of(const std::string& name) {
     } catch (const std::logic_error&) {
     }
   }
-  throw InvalidInput("--motif: expected circle, triangle, square, hexagon or ngon:N, got \"" + name + "\"");
+  const std::string extension = name.size() > 5 ? name.substr(name.size() - 5) : "";
+  if (extension == ".json" || name.substr(name.size() > 4 ? name.size() - 4 : 0) == ".svg") {
+    try {
+      return fill::polygon_motif(fill::read_motif_outline(name));
+    } catch (const InvalidInput& e) {
+      throw InvalidInput(std::string("--motif: ") + e.what());
+    }
+  }
+  throw InvalidInput("--motif: expected circle, triangle, square, hexagon, ngon:N or a motif file (.json points, .svg path), got \"" +
+                     name + "\"");
 }
 
 fill::BoundaryPolicy policy_of(const std::string& name) {
@@ -86,15 +98,37 @@ int fill_pattern(const FillArgs& args) {
   options.gap_mm = args.gap;
   options.seed = args.seed;
   options.random_rotation = args.random_rotation;
+  if (!args.palette.empty() && args.colors.empty()) throw InvalidInput("--palette: only used with --colors");
+  std::vector<std::string> palette = fill::default_palette();
+  if (!args.palette.empty()) {
+    try {
+      palette = fill::parse_palette(args.palette);
+    } catch (const InvalidInput& e) {
+      throw InvalidInput(std::string("--palette: ") + e.what());
+    }
+  }
+  fill::Coloring coloring = fill::Coloring::kOrbit;
+  if (!args.colors.empty()) {
+    try {
+      coloring = fill::coloring_from_name(args.colors);
+    } catch (const InvalidInput& e) {
+      throw InvalidInput(std::string("--colors: ") + e.what());
+    }
+  }
   const fill::WallpaperFill pattern = fill::fill_wallpaper(group, parse_lattice(args.lattice), motif_of(args.motif), options,
                                                           policy_of(args.policy));
+  // Each motif's colour (its images take it too), when asked for.
+  std::vector<std::string> fills;
+  if (!args.colors.empty())
+    for (int c : fill::motif_colors(pattern.fundamental, coloring, int(palette.size()), args.seed))
+      fills.push_back(palette[size_t(c)]);
   if (!args.svg.empty()) {
     // Written whole under a temporary name, then renamed: never a partial picture.
     const std::filesystem::path target(args.svg), temporary = target.string() + ".partial";
     {
       std::ofstream out(temporary, std::ios::binary);
       if (!out) throw IoError(args.svg + ": cannot write the picture");
-      out << fill::wallpaper_svg(pattern, args.cells);
+      out << fill::wallpaper_svg(pattern, args.cells, fills);
       if (!out.flush()) throw IoError(args.svg + ": cannot write the picture");
     }
     std::filesystem::rename(temporary, target);
@@ -102,13 +136,16 @@ int fill_pattern(const FillArgs& args) {
   const fill::FillResult2& r = pattern.fundamental;
   if (args.json) {
     nlohmann::json motifs = nlohmann::json::array();
-    for (const fill::Placement2& p : r.motifs)
+    for (size_t i = 0; i < r.motifs.size(); ++i) {
+      const fill::Placement2& p = r.motifs[i];
       motifs.push_back({{"center", {p.center_mm.x, p.center_mm.y}},
                         {"area", p.area_mm2},
                         {"scale", p.scale},
                         {"angle", p.angle_rad},
                         {"mirrored", p.mirrored},
                         {"stabilizer_order", p.stabilizer_order}});
+      if (!fills.empty()) motifs.back()["color"] = fills[i];
+    }
     nlohmann::json lattice = {{"a", {pattern.lattice.a.x, pattern.lattice.a.y}}, {"b", {pattern.lattice.b.x, pattern.lattice.b.y}}};
     std::cout << nlohmann::json{{"group", fill::group_name(group)}, {"lattice", lattice}, {"c", args.c}, {"N", args.N},
                                 {"seed", args.seed}, {"fill_fraction", r.fill_fraction}, {"stop_reason", r.stop_reason},
@@ -134,7 +171,9 @@ std::function<int()> add_fill_commands(CLI::App& app) {
   pattern->add_option("--lattice", args->lattice, "Lattice vectors \"ax,ay;bx,by\" in mm (default 10,0;0,10)");
   pattern->add_option("--c", args->c, "Exponent of the area rule, > 1 (dimension 2/c)")->check(finite_number());
   pattern->add_option("--N", args->N, "Offset of the area rule, > 1")->check(finite_number());
-  pattern->add_option("--motif", args->motif, "circle, triangle, square, hexagon or ngon:N");
+  pattern->add_option("--motif", args->motif,
+                      "circle, triangle, square, hexagon, ngon:N, or a file: .json (a list of [x, y] points) or .svg (a\n"
+                      "path of straight segments); any simple polygon, its symmetry detected");
   pattern->add_option("--count", args->count, "Most motifs in the fundamental region")
       ->check(CLI::Range(size_t(1), fill::kMaxFillCount));
   pattern->add_option("--max-trials", args->max_trials, "Random positions tried per motif before stopping");
@@ -145,6 +184,10 @@ std::function<int()> add_fill_commands(CLI::App& app) {
   pattern->add_flag("--random-rotation", args->random_rotation, "Turn every motif by a random angle");
   pattern->add_option("--svg", args->svg, "Write an SVG picture of the replicated pattern");
   pattern->add_option("--cells", args->cells, "Unit cells along each side in the picture")->check(CLI::Range(1, 50));
+  pattern->add_option("--colors", args->colors,
+                      "Colour the motifs (each with all its images) by size class (octaves of area), by orbit (one\n"
+                      "colour per motif, in turn) or at random (seeded): size, orbit or random");
+  pattern->add_option("--palette", args->palette, "With --colors: \"#rrggbb,#rrggbb,...\" (default: 8 colours, ColorBrewer Dark2)");
   pattern->add_flag("--json", args->json, "Print JSON: fill_fraction, stop_reason, motifs of the fundamental region");
   return [=]() -> int {
     if (*pattern) return fill_pattern(*args);

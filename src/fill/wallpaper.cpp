@@ -1,6 +1,7 @@
 #include "fill/wallpaper.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -437,7 +438,7 @@ WallpaperFill fill_wallpaper(Group group, const Lattice& lattice, const Motif2& 
   return out;
 }
 
-std::vector<Placement2> replicate(const WallpaperFill& fill, int cells_u, int cells_v) {
+std::vector<Placement2> replicate(const WallpaperFill& fill, int cells_u, int cells_v, std::vector<uint32_t>* orbits) {
   if (cells_u < 1 || cells_v < 1)
     throw InvalidInput("replicate needs at least one cell along each lattice vector, got " + std::to_string(cells_u) +
                        " x " + std::to_string(cells_v));
@@ -446,7 +447,9 @@ std::vector<Placement2> replicate(const WallpaperFill& fill, int cells_u, int ce
   if (count > 1e8) throw ResourceLimit("replicate would make " + std::to_string(count) + " placements, over 100 000 000");
   const Frame f = frame_of(fill.lattice);
   std::vector<Placement2> out;
-  for (const Placement2& pl : fill.fundamental.motifs) {
+  if (orbits) orbits->clear();
+  for (size_t motif = 0; motif < fill.fundamental.motifs.size(); ++motif) {
+    const Placement2& pl = fill.fundamental.motifs[motif];
     std::vector<Vec2d> seen;
     for (const Affine2& op : ops) {
       Placement2 image = transform(op, pl);
@@ -464,14 +467,74 @@ std::vector<Placement2> replicate(const WallpaperFill& fill, int cells_u, int ce
           Placement2 copy = image;
           copy.center_mm = image.center_mm + f.to_world({double(i), double(j)});
           out.push_back(copy);
+          if (orbits) orbits->push_back(uint32_t(motif));
         }
     }
   }
   return out;
 }
 
-std::string wallpaper_svg(const WallpaperFill& pattern, int cells) {
-  const std::vector<Placement2> all = replicate(pattern, cells, cells);
+Coloring coloring_from_name(const std::string& name) {
+  if (name == "size") return Coloring::kSize;
+  if (name == "orbit") return Coloring::kOrbit;
+  if (name == "random") return Coloring::kRandom;
+  throw InvalidInput("expected size, orbit or random, got \"" + name + "\"");
+}
+
+std::vector<int> motif_colors(const FillResult2& fill, Coloring by, int palette_size, uint64_t seed) {
+  if (palette_size < 1) throw InvalidInput("a palette needs at least one colour");
+  std::vector<int> colors;
+  colors.reserve(fill.motifs.size());
+  Random random(seed ^ 0x636f6c6f7572ull);  // its own stream: the placements' generator is not disturbed
+  const double first = fill.motifs.empty() ? 0 : fill.motifs.front().area_mm2;
+  for (size_t i = 0; i < fill.motifs.size(); ++i) {
+    switch (by) {
+      case Coloring::kSize: {
+        // Octaves of area below the first motif's, exact on powers of two.
+        int k = 0;
+        for (double a = first / 2; fill.motifs[i].area_mm2 <= a && k < 1000; a /= 2) ++k;
+        colors.push_back(k % palette_size);
+        break;
+      }
+      case Coloring::kOrbit: colors.push_back(int(i % size_t(palette_size))); break;
+      case Coloring::kRandom: colors.push_back(int(random.next() % uint64_t(palette_size))); break;
+    }
+  }
+  return colors;
+}
+
+std::vector<std::string> parse_palette(const std::string& text) {
+  std::vector<std::string> palette;
+  size_t start = 0;
+  while (start <= text.size()) {
+    const size_t comma = text.find(',', start);
+    std::string c = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    while (!c.empty() && std::isspace(static_cast<unsigned char>(c.front()))) c.erase(c.begin());
+    while (!c.empty() && std::isspace(static_cast<unsigned char>(c.back()))) c.pop_back();
+    bool ok = c.size() == 7 && c[0] == '#';
+    for (size_t k = 1; ok && k < 7; ++k) ok = std::isxdigit(static_cast<unsigned char>(c[k])) != 0;
+    if (!ok)
+      throw InvalidInput("colour " + std::to_string(palette.size() + 1) + " \"" + c + "\" is not #rrggbb (e.g. #1b9e77)");
+    for (char& ch : c) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+    palette.push_back(c);
+    if (palette.size() > 64) throw InvalidInput("a palette has at most 64 colours");
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return palette;
+}
+
+std::vector<std::string> default_palette() {
+  return {"#1b9e77", "#d95f02", "#7570b3", "#e7298a", "#66a61e", "#e6ab02", "#a6761d", "#666666"};
+}
+
+std::string wallpaper_svg(const WallpaperFill& pattern, int cells, const std::vector<std::string>& fills) {
+  if (!fills.empty() && fills.size() != pattern.fundamental.motifs.size())
+    throw InvalidInput("one colour per motif of the fundamental region is needed: " +
+                       std::to_string(pattern.fundamental.motifs.size()) + " motifs, " + std::to_string(fills.size()) +
+                       " colours");
+  std::vector<uint32_t> orbits;
+  const std::vector<Placement2> all = replicate(pattern, cells, cells, &orbits);
   const Lattice& l = pattern.lattice;
   Vec2d lo{HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL};
   for (const Vec2d& q : {Vec2d{0, 0}, l.a * double(cells), l.b * double(cells), (l.a + l.b) * double(cells)}) {
@@ -484,14 +547,16 @@ std::string wallpaper_svg(const WallpaperFill& pattern, int cells) {
                 "<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"%.6g %.6g %.6g %.6g\" width=\"800\">\n", lo.x,
                 -hi.y, hi.x - lo.x, hi.y - lo.y);
   s << buf << "<g transform=\"scale(1,-1)\">\n";
-  for (const Placement2& p : all) {
+  for (size_t k = 0; k < all.size(); ++k) {
+    const Placement2& p = all[k];
+    const char* colour = fills.empty() ? "black" : fills[orbits[k]].c_str();
     if (pattern.motif.kind == Motif2::Kind::kCircle) {
-      std::snprintf(buf, sizeof buf, "<circle cx=\"%.9g\" cy=\"%.9g\" r=\"%.9g\" fill=\"black\"/>\n", p.center_mm.x,
-                    p.center_mm.y, p.scale / std::sqrt(3.14159265358979323846));
+      std::snprintf(buf, sizeof buf, "<circle cx=\"%.9g\" cy=\"%.9g\" r=\"%.9g\" fill=\"%s\"/>\n", p.center_mm.x,
+                    p.center_mm.y, p.scale / std::sqrt(3.14159265358979323846), colour);
       s << buf;
       continue;
     }
-    s << "<polygon fill=\"black\" points=\"";
+    s << "<polygon fill=\"" << colour << "\" points=\"";
     for (const Vec2d& q : placed_outline(pattern.motif, p)) {
       std::snprintf(buf, sizeof buf, "%.9g,%.9g ", q.x, q.y);
       s << buf;

@@ -85,11 +85,33 @@ WallpaperFill fill_wallpaper(Group group, const Lattice& lattice, const Motif2& 
 // Every image of every motif whose centre lies in the parallelogram {u a + v b : 0 <= u < cells_u,
 // 0 <= v < cells_v}; images that coincide (a snapped motif and its stabilizer) appear once. Throws
 // InvalidInput unless both counts are >= 1, ResourceLimit past 100 000 000 placements.
-std::vector<Placement2> replicate(const WallpaperFill& fill, int cells_u, int cells_v);
+// `orbits`, when given, receives for each placement the index of the fundamental region's motif it is an
+// image of.
+std::vector<Placement2> replicate(const WallpaperFill& fill, int cells_u, int cells_v,
+                                  std::vector<uint32_t>* orbits = nullptr);
 
-// The pattern replicated over cells x cells unit cells as an SVG picture (motifs black, y up), the
-// fundamental region outlined in red. Throws as replicate().
-std::string wallpaper_svg(const WallpaperFill& pattern, int cells);
+// How the motifs of a pattern are coloured; every image of a motif takes its motif's colour, so the
+// colouring keeps the pattern's symmetry.
+enum class Coloring {
+  kSize,    // by size class: class k holds the areas in (A_0 / 2^(k+1), A_0 / 2^k], A_0 the first motif's
+  kOrbit,   // by orbit under the group: motif i (and all its images) takes colour i mod the palette's size
+  kRandom,  // each motif a colour drawn uniformly from the palette (seeded)
+};
+// "size", "orbit" or "random"; throws InvalidInput otherwise.
+Coloring coloring_from_name(const std::string& name);
+// The palette index (0 .. palette_size - 1) of each motif of the fundamental region, in placement order.
+// Throws InvalidInput unless palette_size >= 1.
+std::vector<int> motif_colors(const FillResult2& fill, Coloring by, int palette_size, uint64_t seed);
+// "#rrggbb,#rrggbb,..." (1 to 64 colours, hexadecimal digits either case) as lower-case "#rrggbb"
+// strings; throws InvalidInput naming the entry that is not one.
+std::vector<std::string> parse_palette(const std::string& text);
+// Eight colours that tell apart in print and on screen (ColorBrewer's Dark2).
+std::vector<std::string> default_palette();
+
+// The pattern replicated over cells x cells unit cells as an SVG picture (y up), the fundamental region
+// outlined in red: motifs black, or each in the colour `fills` gives its orbit (one "#rrggbb" per motif of
+// the fundamental region). Throws as replicate(), and InvalidInput when `fills` is given with another size.
+std::string wallpaper_svg(const WallpaperFill& pattern, int cells, const std::vector<std::string>& fills = {});
 
 }  // namespace fill
 }  // namespace lacuna

@@ -11,6 +11,7 @@
 #include "cifs/nurbs.h"
 #include "curves/sweep.h"
 #include "fill/fill.h"
+#include "fill/motif_file.h"
 #include "fill/wallpaper.h"
 #include "pipeline/build_inputs.h"
 #include "python/convert.h"
@@ -82,9 +83,14 @@ fill::Motif2 motif_of(const py::handle& motif) {
     if (name == "triangle") return fill::regular_polygon_motif(3);
     if (name == "square") return fill::regular_polygon_motif(4);
     if (name == "hexagon") return fill::regular_polygon_motif(6);
-    throw InvalidInput(
-        "motif: expected circle, triangle, square, hexagon, a number of sides or an N x 2 polygon, got \"" + name +
-        "\"");
+    if (name.find('.') == std::string::npos)
+      throw InvalidInput(
+          "motif: expected circle, triangle, square, hexagon, a number of sides, an N x 2 polygon or a motif file "
+          "(.json, .svg), got \"" + name + "\"");
+  }
+  if (py::isinstance<py::str>(motif) || py::hasattr(motif, "__fspath__")) {
+    const std::string file = path_of(motif);
+    return about("motif", [&] { return fill::polygon_motif(fill::read_motif_outline(file)); });
   }
   if (py::isinstance<py::int_>(motif)) {
     const int n = motif.cast<int>();
@@ -377,7 +383,8 @@ void add_generators(py::module_& m) {
   m.def(
       "fill_pattern",
       [](const std::string& group, const py::handle& lattice, double c, double N, const py::handle& motif, size_t count,
-         size_t max_trials, double gap_mm, uint64_t seed, const std::string& policy, bool random_rotation, int cells) {
+         size_t max_trials, double gap_mm, uint64_t seed, const std::string& policy, bool random_rotation, int cells,
+         const py::object& colors, const py::object& palette) {
         const fill::Group g = about("group", [&] { return fill::group_from_name(group); });
         py::array_t<double, py::array::c_style | py::array::forcecast> l = py::array_t<double>::ensure(lattice);
         if (!l || l.ndim() != 2 || l.shape(0) != 2 || l.shape(1) != 2)
@@ -408,20 +415,42 @@ void add_generators(py::module_& m) {
         d["stop_reason"] = pattern.fundamental.stop_reason;
         d["motifs"] = placements_dict(pattern.motif, pattern.fundamental.motifs, false);
         d["fundamental_region"] = points_array(fill::fundamental_region_mm(g, pattern.lattice));
-        if (cells > 0) d["pattern"] = placements_dict(pattern.motif, fill::replicate(pattern, cells, cells), true);
+        std::vector<uint32_t> orbits;
+        if (cells > 0) d["pattern"] = placements_dict(pattern.motif, fill::replicate(pattern, cells, cells, &orbits), true);
+        if (!palette.is_none() && colors.is_none()) throw InvalidInput("palette: only used with colors");
+        if (!colors.is_none()) {
+          const fill::Coloring by = about("colors", [&] { return fill::coloring_from_name(colors.cast<std::string>()); });
+          std::string listed;  // the palette as "#rrggbb,..."
+          if (py::isinstance<py::str>(palette)) {
+            listed = palette.cast<std::string>();
+          } else if (!palette.is_none()) {
+            for (const py::handle& entry : palette) listed += (listed.empty() ? "" : ",") + entry.cast<std::string>();
+          }
+          const std::vector<std::string> colours =
+              palette.is_none() ? fill::default_palette() : about("palette", [&] { return fill::parse_palette(listed); });
+          py::list motif_colours, pattern_colours;
+          const std::vector<int> index = fill::motif_colors(pattern.fundamental, by, int(colours.size()), seed);
+          for (int k : index) motif_colours.append(colours[size_t(k)]);
+          for (uint32_t o : orbits) pattern_colours.append(colours[size_t(index[o])]);
+          d["colors"] = motif_colours;
+          if (cells > 0) d["pattern_colors"] = pattern_colours;
+        }
         return d;
       },
       py::arg("group") = "p1", py::arg("lattice") = std::vector<std::vector<double>>{{10, 0}, {0, 10}},
       py::arg("c") = 1.3, py::arg("N") = 2.0, py::arg("motif") = "circle", py::arg("count") = 1000,
       py::arg("max_trials") = 100000, py::arg("gap_mm") = 0.0, py::arg("seed") = 1, py::arg("policy") = "reject",
-      py::arg("random_rotation") = false, py::arg("cells") = 0,
+      py::arg("random_rotation") = false, py::arg("cells") = 0, py::arg("colors") = py::none(),
+      py::arg("palette") = py::none(),
       "Fills a wallpaper group's fundamental region by the area rule A / (zeta(c, N) (N + i)^c), as `lacuna fill "
       "pattern`: group (p1 ... p6m), lattice [[ax, ay], [bx, by]] (mm), motif (circle, triangle, square, hexagon, a "
       "number of sides, or an N x 2 polygon), gap_mm (mm) between motifs and their images, policy for motifs meeting "
       "a mirror or rotation centre (allow, reject, snap). Returns fill_fraction, stop_reason, the motifs of the "
       "fundamental region as arrays (center N x 2 mm, area mm^2, scale, angle rad, mirrored, stabilizer_order), the "
       "fundamental_region polygon, and with cells > 0 the pattern replicated over cells x cells unit cells with "
-      "every motif's outline (mm).");
+      "every motif's outline (mm). motif may also be a file (.json points, .svg path). colors (size, orbit or "
+      "random, from palette: \"#rrggbb,...\" or a list) adds colors (one per motif) and pattern_colors (one per "
+      "replicated motif).");
   m.def(
       "voronoi_rules",
       [](int dimension, int d, const py::object& points, int random, uint64_t seed, const std::string& children) {

@@ -1,9 +1,11 @@
 // The random fractal fillings: motifs in a region or a wallpaper pattern, spheres or polyhedra in a volume.
 #include <cmath>
+#include <filesystem>
 #include <string>
 #include <vector>
 
 #include "errors.h"
+#include "fill/motif_file.h"
 #include "recipe/input_parsers.h"
 
 namespace lacuna {
@@ -34,20 +36,27 @@ Motif2 parse_motif(const JsonObject& o) {
       if (name == "square") return regular_polygon_motif(4);
       if (name == "triangle") return regular_polygon_motif(3);
       if (name == "hexagon") return regular_polygon_motif(6);
-      o.fail("motif", "expected \"circle\", \"triangle\", \"square\", \"hexagon\", {\"regular_polygon\": n} or {\"polygon\": [[x, y], ...]}, got \"" + name + "\"");
+      o.fail("motif", "expected \"circle\", \"triangle\", \"square\", \"hexagon\", {\"regular_polygon\": n}, {\"polygon\": [[x, y], ...]} or {\"file\": \"motif.svg\"}, got \"" + name + "\"");
     }
     JsonObject m = o.object("motif");
-    m.allow_only({"regular_polygon", "polygon"});
+    m.allow_only({"regular_polygon", "polygon", "file"});
+    if (m.has("file")) {  // relative to the recipe's folder
+      const std::string name = m.string("file");
+      const std::filesystem::path file = std::filesystem::path(o.file()).parent_path() / name;
+      return polygon_motif(read_motif_outline(file.string()));
+    }
     if (m.has("regular_polygon")) {
       const uint64_t n = m.unsigned_integer_or("regular_polygon", 0);
       if (n < 3 || n > 1000) m.fail("regular_polygon", "expected 3 to 1000 sides");
       return regular_polygon_motif(int(n));
     }
     if (m.has("polygon")) return polygon_motif(vec2_list(m, "polygon"));
-    o.fail("motif", "expected {\"regular_polygon\": n} or {\"polygon\": [[x, y], ...]}");
+    o.fail("motif", "expected {\"regular_polygon\": n}, {\"polygon\": [[x, y], ...]} or {\"file\": \"motif.svg\"} (.json or .svg)");
   } catch (const InvalidInput& e) {
     if (std::string(e.what()).find(o.file()) == 0) throw;
     o.fail("motif", e.what());
+  } catch (const IoError& e) {
+    throw IoError(o.file() + ": " + o.path_of("motif") + ": " + e.what());
   }
 }
 

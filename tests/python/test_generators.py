@@ -136,6 +136,30 @@ def test_fill_pattern_follows_the_area_law():
         lacuna.fill_pattern(group="p7")
 
 
+def test_fill_pattern_colours_and_motif_files(tmp_path):
+    # Without snapping motif i's size class is floor(c log2((N + i) / N)); every image takes its motif's colour.
+    palette = ["#000001", "#000002", "#000003"]
+    p = lacuna.fill_pattern(group="p2", c=1.3, N=2.0, count=30, seed=4, cells=2, colors="size", palette=palette)
+    n = len(p["colors"])
+    assert n == len(p["motifs"]["area"]) and n > 10
+    for i, colour in enumerate(p["colors"]):
+        assert colour == palette[math.floor(1.3 * math.log2((2 + i) / 2) + 1e-12) % 3]
+    assert len(p["pattern_colors"]) == 2 * 4 * n  # p2: two images per motif and cell, 2 x 2 cells
+    assert sorted(set(p["pattern_colors"])) == sorted(set(p["colors"]))
+    orbit = lacuna.fill_pattern(group="p2", count=30, seed=4, colors="orbit", palette="#ff0000,#00ff00")
+    assert orbit["colors"][:4] == ["#ff0000", "#00ff00", "#ff0000", "#00ff00"]
+    # A motif from a file: an L-shaped hexagon as an SVG path and as JSON points fill alike.
+    (tmp_path / "ell.svg").write_text('<svg><path d="M0,0 h2 v1 h-1 v1 H0 Z"/></svg>')
+    (tmp_path / "ell.json").write_text("[[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]]")
+    a = lacuna.fill_pattern(group="p2", count=20, seed=2, motif=tmp_path / "ell.svg")
+    b = lacuna.fill_pattern(group="p2", count=20, seed=2, motif=str(tmp_path / "ell.json"))
+    assert len(a["motifs"]["area"]) == len(b["motifs"]["area"])
+    with pytest.raises(lacuna.InvalidInputError, match="colors"):
+        lacuna.fill_pattern(colors="rainbow")
+    with pytest.raises(lacuna.InvalidInputError, match="palette"):
+        lacuna.fill_pattern(colors="orbit", palette="#12345")
+
+
 def test_voronoi_rules_of_the_worked_example():
     example = [[0.86, 0.3], [0.3, 0.65], [0.73, 0.85]]
     r = lacuna.voronoi_rules(dimension=2, d=2, points=example, children="shifted")

@@ -482,7 +482,7 @@ def fill_pattern(
     lattice: npt.ArrayLike = ((10.0, 0.0), (0.0, 10.0)),
     c: float = 1.3,
     N: float = 2.0,
-    motif: Union[str, int, npt.ArrayLike] = "circle",
+    motif: Union[str, int, os.PathLike, npt.ArrayLike] = "circle",
     count: int = 1000,
     max_trials: int = 100000,
     gap_mm: float = 0.0,
@@ -490,6 +490,8 @@ def fill_pattern(
     policy: Literal["allow", "reject", "snap"] = "reject",
     random_rotation: bool = False,
     cells: int = 0,
+    colors: Optional[Literal["size", "orbit", "random"]] = None,
+    palette: Union[None, str, Sequence[str]] = None,
 ) -> Dict[str, Any]: ...
 def voronoi_rules(
     dimension: int = 2,
