@@ -500,6 +500,7 @@ std::vector<BadCase> bad_cases() {
       {"fill_motifs_bad_polygon", with_input(R"({"type": "fill_motifs", "motif": {"polygon": [[0, 0], [1, 1], [1, 0], [0, 1]]}, "height_mm": 1, "region": {"disk": {"radius_mm": 5}}})"), "", "", "inputs.x.motif"},
       {"fill_motifs_missing_file", with_input(R"({"type": "fill_motifs", "motif": {"file": "nowhere.svg"}, "height_mm": 1, "region": {"disk": {"radius_mm": 5}}})"), "", "", "nowhere.svg"},
       {"fill_motifs_file_kind", with_input(R"({"type": "fill_motifs", "motif": {"file": "motif.png"}, "height_mm": 1, "region": {"disk": {"radius_mm": 5}}})"), "", "", "inputs.x.motif"},
+      {"fill_motifs_color_keep", with_input(R"({"type": "fill_motifs", "motif": "circle", "height_mm": 1, "region": {"disk": {"radius_mm": 5}}, "color_class": {"by": "orbit", "classes": 2, "keep": 2}})"), "", "", "inputs.x.color_class.keep"},
       {"fill_spheres_two_regions", with_input(R"({"type": "fill_spheres", "box": {"min_mm": [0,0,0], "max_mm": [5,5,5]}, "sphere": {"radius_mm": 3}})"), "", "", "one region"},
       {"fill_spheres_bad_motif", with_input(R"({"type": "fill_spheres", "motif": "dodecahedron", "sphere": {"radius_mm": 3}})"), "", "", "inputs.x.motif"},
       {"bcifs_infill_grade_levels", R"({"inputs": {"h": {"type": "sphere", "radius_mm": 8}, "x": {"type": "bcifs_infill",
@@ -647,6 +648,29 @@ TEST(Cli, FillPatternJsonSvgAndDeterminism) {
   Result bad_lattice = lacuna("fill pattern --group p4 --lattice " + quote("10,0;0,7"), dir.path());
   EXPECT_EQ(bad_lattice.code, 2);
   EXPECT_NE(bad_lattice.err.find("p4"), std::string::npos) << bad_lattice.err;
+}
+
+TEST(Cli, FillMotifsColourClassesSplitOnePattern) {
+  // The same p4 pattern whole and split by orbit into two classes written as one two-object 3MF: the
+  // classes hold every other motif of the fundamental region (orbit colouring is i mod 2) and together
+  // all of the pattern's images (4 per motif and cell, 2 x 2 cells).
+  TempDir dir;
+  const std::string fill = R"("type": "fill_motifs", "motif": "circle", "height_mm": 1, "count": 12, "seed": 3,
+      "wallpaper": {"group": "p4", "a_mm": [6, 0], "b_mm": [0, 6], "cells": [2, 2]})";
+  write_file(dir / "split.json", R"({"lacuna_recipe": 1, "name": "split", "voxel_size_mm": 0.1, "inputs": {
+      "all": {)" + fill + R"(},
+      "even": {)" + fill + R"(, "color_class": {"by": "orbit", "classes": 2, "keep": 0}},
+      "odd": {)" + fill + R"(, "color_class": {"by": "orbit", "classes": 2, "keep": 1}}},
+    "outputs": [{"of": "all", "file": "all.stl"}, {"of": ["even", "odd"], "file": "two.3mf"}]})");
+  Result r = lacuna("run " + quote((dir / "split.json").string()) + " -o " + quote((dir / "out").string()), dir.path());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json report = nlohmann::json::parse(read_file(dir / "out" / "report.json"));
+  const nlohmann::json& in = report["inputs"];
+  EXPECT_EQ(in["all"]["fundamental_region_motifs"], 12);
+  EXPECT_EQ(in["even"]["fundamental_region_motifs"], 6);
+  EXPECT_EQ(in["odd"]["fundamental_region_motifs"], 6);
+  EXPECT_EQ(in["all"]["motifs"], 12 * 4 * 4);
+  EXPECT_EQ(in["even"]["motifs"].get<int>() + in["odd"]["motifs"].get<int>(), 12 * 4 * 4);
 }
 
 TEST(Cli, FillPatternMotifFilesAndColours) {

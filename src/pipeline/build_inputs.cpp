@@ -293,10 +293,21 @@ class Builder {
     fill::MotifSolidOptions solid = f.solid;
     std::vector<fill::Placement2> placements;
     try {
+      // The colour class of each motif of the fill (all its images share it), when only one is kept.
+      auto kept = [&](const fill::FillResult2& r) {
+        std::vector<uint8_t> keep(r.motifs.size(), 1);
+        if (f.color_class) {
+          const std::vector<int> colors = fill::motif_colors(r, f.color_class->by, f.color_class->classes, f.fill.seed);
+          for (size_t i = 0; i < keep.size(); ++i) keep[i] = colors[i] == f.color_class->keep;
+        }
+        return keep;
+      };
       if (!f.wallpaper) {
         fill::FillResult2 r = fill::fill_region(f.region, f.motif, f.fill);
-        out_.report = MotifFillReport{r.motifs.size(), std::nullopt, r.fill_fraction, r.stop_reason};
-        placements = std::move(r.motifs);
+        const std::vector<uint8_t> keep = kept(r);
+        for (size_t i = 0; i < r.motifs.size(); ++i)
+          if (keep[i]) placements.push_back(r.motifs[i]);
+        out_.report = MotifFillReport{placements.size(), std::nullopt, r.fill_fraction, r.stop_reason};
       } else {
         fill::WallpaperFill pattern;
         try {
@@ -305,9 +316,15 @@ class Builder {
           if (names_recipe(e)) throw;
           fail("wallpaper", e.what());
         }
-        placements = fill::replicate(pattern, f.cells_u, f.cells_v);
+        std::vector<uint32_t> orbits;
+        const std::vector<fill::Placement2> all = fill::replicate(pattern, f.cells_u, f.cells_v, &orbits);
+        const std::vector<uint8_t> keep = kept(pattern.fundamental);
+        for (size_t i = 0; i < all.size(); ++i)
+          if (keep[orbits[i]]) placements.push_back(all[i]);
+        size_t fundamental = 0;
+        for (uint8_t k : keep) fundamental += k;
         out_.pattern = std::make_shared<const fill::WallpaperFill>(pattern);
-        out_.report = MotifFillReport{placements.size(), pattern.fundamental.motifs.size(), pattern.fundamental.fill_fraction,
+        out_.report = MotifFillReport{placements.size(), fundamental, pattern.fundamental.fill_fraction,
                                       pattern.fundamental.stop_reason};
         if (f.wrap_depth_mm > 0) {
           // The pattern's period along x, times the cells, is the circumference.
@@ -322,6 +339,9 @@ class Builder {
       if (names_recipe(e)) throw;
       fail("", e.what());
     }
+    if (placements.empty() && f.color_class)
+      fail("color_class", "no motif has colour class " + std::to_string(f.color_class->keep) + " of " +
+                              std::to_string(f.color_class->classes));
     if (placements.empty()) fail("", "no motif could be placed");
     out_.geometry = fill::motif_solids(f.motif, placements, solid);
   }

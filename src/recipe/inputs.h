@@ -141,6 +141,15 @@ struct FillMotifsInput {
   int cells_u = 1, cells_v = 1;   // unit cells of the pattern along a and b
   fill::BoundaryPolicy policy = fill::BoundaryPolicy::kReject;
   double wrap_depth_mm = 0;       // > 0: wrapped around the cylinder the pattern's width goes round, this deep
+  // "color_class": only the motifs (with all their images) of colour `keep` among `classes`, coloured as
+  // `fill pattern --colors` does (fill::motif_colors with the fill's seed): inputs that differ only in
+  // `keep` split one pattern into disjoint objects, e.g. for the parts of a multi-material 3MF.
+  struct ColorClass {
+    fill::Coloring by = fill::Coloring::kSize;
+    int classes = 2;
+    int keep = 0;
+  };
+  std::optional<ColorClass> color_class;
 };
 
 // "fill_spheres": a random fractal filling of a volume with spheres or convex polyhedra.

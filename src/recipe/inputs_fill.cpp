@@ -115,6 +115,24 @@ void parse_law(const JsonObject& o, Options& f) {
 FillMotifsInput parse_fill_motifs_input(const JsonObject& o) {
   FillMotifsInput in;
   in.motif = parse_motif(o);
+  if (o.has("color_class")) {
+    JsonObject c = o.object("color_class");
+    c.allow_only({"by", "classes", "keep"});
+    FillMotifsInput::ColorClass cc;
+    try {
+      cc.by = coloring_from_name(c.string_or("by", "size"));
+    } catch (const InvalidInput& e) {
+      c.fail("by", e.what());
+    }
+    const uint64_t classes = c.unsigned_integer_or("classes", 2);
+    if (classes < 1 || classes > 64) c.fail("classes", "expected 1 to 64 colour classes");
+    cc.classes = int(classes);
+    if (!c.has("keep")) c.fail("keep", "expected the class to keep, 0 to " + std::to_string(classes - 1));
+    const uint64_t keep = c.unsigned_integer_or("keep", 0);
+    if (keep >= classes) c.fail("keep", "expected a class from 0 to " + std::to_string(classes - 1));
+    cc.keep = int(keep);
+    in.color_class = cc;
+  }
   FillOptions& f = in.fill;
   parse_law(o, f);
   f.min_area_mm2 = o.has("min_area_mm2") ? o.positive_length("min_area_mm2") : 0.0;

@@ -64,7 +64,7 @@ const std::map<std::string, InputType>& types() {
               parse_as<CurveInput, parse_curve_input>},
              {"fill_motifs",
               {"motif", "region", "wallpaper", "c", "N", "count", "min_area_mm2", "max_trials", "gap_mm", "boundary_gap_mm",
-               "seed", "random_rotation", "height_mm", "base_z_mm", "wrap"},
+               "seed", "random_rotation", "height_mm", "base_z_mm", "wrap", "color_class"},
               parse_as<FillMotifsInput, parse_fill_motifs_input>},
              {"fill_spheres",
               {"fit_to", "box", "sphere", "motif", "random_rotation", "c", "N", "count", "min_radius_mm", "max_trials",
