@@ -214,8 +214,8 @@ struct Vertices {
 // Two ways to guard: `guarded` tests every collapse against every triangle near it (a grid of
 // the region, updated as triangles change); otherwise a collapse is tested against the triangles
 // that share its vertices, and verify() then tests the pairs of nearby triangles of the result
-// that share none with exact predicates. A region whose result fails verify() is simplified again, guarded, from
-// its input, so nothing untested leaves it either way; the second way is several times faster and
+// that share none with exact predicates. A region whose result fails verify() is simplified
+// again, guarded, from its input, so nothing untested leaves it either way; the second way is several times faster and
 // almost never has to redo a region.
 class RegionSimplifier {
  public:
@@ -685,7 +685,6 @@ class RegionSimplifier {
     const int k = state / 2, i = (k + 1) % 3, j = (k + 2) % 3, sign = (state & 1) ? -1 : 1;
     return exact::orient2d(v[i], v[j], a[i], a[j], b[i], b[j]) == sign;
   }
-
 
   // Whether p lies within the deviation of triangle abc (its box first).
   bool within_deviation(const Vec3d& p, const Vec3d& a, const Vec3d& b, const Vec3d& c) const {

@@ -64,10 +64,9 @@ fill::Motif2 motif_of(const std::string& name) {
     } catch (const std::logic_error&) {
     }
   }
-  const std::string extension = name.size() > 5 ? name.substr(name.size() - 5) : "";
-  if (extension == ".json" || name.substr(name.size() > 4 ? name.size() - 4 : 0) == ".svg") {
+  if (fill::names_motif_file(name)) {
     try {
-      return fill::polygon_motif(fill::read_motif_outline(name));
+      return fill::motif_from_file(name);
     } catch (const InvalidInput& e) {
       throw InvalidInput(std::string("--motif: ") + e.what());
     }
@@ -119,9 +118,7 @@ int fill_pattern(const FillArgs& args) {
                                                           policy_of(args.policy));
   // Each motif's colour (its images take it too), when asked for.
   std::vector<std::string> fills;
-  if (!args.colors.empty())
-    for (int c : fill::motif_colors(pattern.fundamental, coloring, int(palette.size()), args.seed))
-      fills.push_back(palette[size_t(c)]);
+  if (!args.colors.empty()) fills = fill::motif_palette_colors(pattern.fundamental, coloring, palette, args.seed);
   if (!args.svg.empty()) {
     // Written whole under a temporary name, then renamed: never a partial picture.
     const std::filesystem::path target(args.svg), temporary = target.string() + ".partial";

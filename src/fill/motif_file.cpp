@@ -143,12 +143,18 @@ std::vector<Vec2d> svg_path_points(const std::string& d, const std::string& wher
   return points;
 }
 
+bool names_motif_file(const std::string& name) {
+  const std::string extension = lower_extension(name);
+  return extension == ".json" || extension == ".svg";
+}
+
+Motif2 motif_from_file(const std::string& path) { return polygon_motif(read_motif_outline(path)); }
+
 std::vector<Vec2d> read_motif_outline(const std::string& path) {
-  const std::string extension = lower_extension(path);
-  if (extension != ".json" && extension != ".svg")
+  if (!names_motif_file(path))
     throw InvalidInput(path + ": expected a .json (a list of [x, y] points) or .svg (a path) motif file");
   const std::string text = read_text_file(path, "the motif file", kMaxMotifFileBytes);
-  if (extension == ".json") return json_outline(text, path);
+  if (lower_extension(path) == ".json") return json_outline(text, path);
   std::vector<Vec2d> points = svg_path_points(first_path_data(text, path), path);
   for (Vec2d& p : points) p.y = -p.y;  // SVG's y axis points down
   return points;

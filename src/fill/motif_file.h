@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "fill/fill.h"
 #include "geometry.h"
 
 namespace lacuna {
@@ -21,6 +22,11 @@ std::vector<Vec2d> svg_path_points(const std::string& d, const std::string& wher
 // negated). Throws IoError when the file cannot be read and InvalidInput naming the file and what
 // is wrong with it; the outline is checked as polygon_motif() does.
 std::vector<Vec2d> read_motif_outline(const std::string& path);
+
+// Whether a motif name is a file name read_motif_outline() takes (it ends in .json or .svg, either case).
+bool names_motif_file(const std::string& name);
+// The motif of the outline in a file: polygon_motif(read_motif_outline(path)), its symmetry detected.
+Motif2 motif_from_file(const std::string& path);
 
 }  // namespace fill
 }  // namespace lacuna

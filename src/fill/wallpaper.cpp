@@ -503,6 +503,13 @@ std::vector<int> motif_colors(const FillResult2& fill, Coloring by, int palette_
   return colors;
 }
 
+std::vector<std::string> motif_palette_colors(const FillResult2& fill, Coloring by, const std::vector<std::string>& palette,
+                                              uint64_t seed) {
+  std::vector<std::string> colors;
+  for (int c : motif_colors(fill, by, int(palette.size()), seed)) colors.push_back(palette[size_t(c)]);
+  return colors;
+}
+
 std::vector<std::string> parse_palette(const std::string& text) {
   std::vector<std::string> palette;
   size_t start = 0;

@@ -102,6 +102,9 @@ Coloring coloring_from_name(const std::string& name);
 // The palette index (0 .. palette_size - 1) of each motif of the fundamental region, in placement order.
 // Throws InvalidInput unless palette_size >= 1.
 std::vector<int> motif_colors(const FillResult2& fill, Coloring by, int palette_size, uint64_t seed);
+// The same as palette entries: motif i takes palette[motif_colors(...)[i]]. Throws as motif_colors().
+std::vector<std::string> motif_palette_colors(const FillResult2& fill, Coloring by, const std::vector<std::string>& palette,
+                                              uint64_t seed);
 // "#rrggbb,#rrggbb,..." (1 to 64 colours, hexadecimal digits either case) as lower-case "#rrggbb"
 // strings; throws InvalidInput naming the entry that is not one.
 std::vector<std::string> parse_palette(const std::string& text);

@@ -83,14 +83,14 @@ fill::Motif2 motif_of(const py::handle& motif) {
     if (name == "triangle") return fill::regular_polygon_motif(3);
     if (name == "square") return fill::regular_polygon_motif(4);
     if (name == "hexagon") return fill::regular_polygon_motif(6);
-    if (name.find('.') == std::string::npos)
+    if (!fill::names_motif_file(name))
       throw InvalidInput(
           "motif: expected circle, triangle, square, hexagon, a number of sides, an N x 2 polygon or a motif file "
           "(.json, .svg), got \"" + name + "\"");
   }
   if (py::isinstance<py::str>(motif) || py::hasattr(motif, "__fspath__")) {
     const std::string file = path_of(motif);
-    return about("motif", [&] { return fill::polygon_motif(fill::read_motif_outline(file)); });
+    return about("motif", [&] { return fill::motif_from_file(file); });
   }
   if (py::isinstance<py::int_>(motif)) {
     const int n = motif.cast<int>();
@@ -428,10 +428,10 @@ void add_generators(py::module_& m) {
           }
           const std::vector<std::string> colours =
               palette.is_none() ? fill::default_palette() : about("palette", [&] { return fill::parse_palette(listed); });
+          const std::vector<std::string> of_motif = fill::motif_palette_colors(pattern.fundamental, by, colours, seed);
           py::list motif_colours, pattern_colours;
-          const std::vector<int> index = fill::motif_colors(pattern.fundamental, by, int(colours.size()), seed);
-          for (int k : index) motif_colours.append(colours[size_t(k)]);
-          for (uint32_t o : orbits) pattern_colours.append(colours[size_t(index[o])]);
+          for (const std::string& colour : of_motif) motif_colours.append(colour);
+          for (uint32_t o : orbits) pattern_colours.append(of_motif[o]);
           d["colors"] = motif_colours;
           if (cells > 0) d["pattern_colors"] = pattern_colours;
         }

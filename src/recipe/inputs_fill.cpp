@@ -43,7 +43,7 @@ Motif2 parse_motif(const JsonObject& o) {
     if (m.has("file")) {  // relative to the recipe's folder
       const std::string name = m.string("file");
       const std::filesystem::path file = std::filesystem::path(o.file()).parent_path() / name;
-      return polygon_motif(read_motif_outline(file.string()));
+      return motif_from_file(file.string());
     }
     if (m.has("regular_polygon")) {
       const uint64_t n = m.unsigned_integer_or("regular_polygon", 0);
