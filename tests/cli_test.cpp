@@ -851,6 +851,33 @@ TEST(Cli, BcifsRulesPlateAndMeasure) {
   EXPECT_TRUE(fs::exists(dir / "m" / "plate_density.png"));
   EXPECT_TRUE(fs::exists(dir / "m" / "plate_plot.png"));
   EXPECT_EQ(read_file(dir / "m" / "plate_plot.png").substr(1, 3), "PNG");
+
+  // "realization": "paper" reaches the recipe: F0's published F_A, F_P and D_box within 3 %; the three keys given
+  // explicitly override the preset (here back to the defaults: the default plate's measures exactly); a bad
+  // name is refused naming the key.
+  auto measure = [&](const std::string& extra) {
+    write_file(dir / "p.json", R"({"inputs": {"plate": {"type": "bcifs_plate", "face": {"boundary": "C2 B2 C2 B2 C2 B2"},
+        "radius_mm": 8, "level": 2)" + extra + R"(}}, "outputs": [{"of": "plate", "file": "plate.stl"}]})");
+    return lacuna("bcifs measure " + quote((dir / "p.json").string()) + " --levels 0..5 -o " +
+                      quote((dir / "pm").string()) + " --json",
+                  dir.path());
+  };
+  Result paper = measure(R"(, "realization": "paper")");
+  ASSERT_EQ(paper.code, 0) << paper.err;
+  const nlohmann::json pj = nlohmann::json::parse(paper.out)["plate"];
+  EXPECT_NEAR(pj["F_A"].get<double>() / 0.76, 1, 0.03);
+  EXPECT_NEAR(pj["F_P"].get<double>() / 1.97, 1, 0.03);
+  EXPECT_NEAR(pj["box_counting"]["region_dimension"].get<double>() / 1.65, 1, 0.03);
+  Result back = measure(R"(, "realization": "paper", "lacuna_scale": 0.35, "gap_fraction": 0.2, "notch_depth": 0.3)");
+  Result plain = measure("");
+  ASSERT_EQ(back.code, 0) << back.err;
+  ASSERT_EQ(plain.code, 0) << plain.err;
+  EXPECT_EQ(nlohmann::json::parse(back.out)["plate"]["area_mm2"], nlohmann::json::parse(plain.out)["plate"]["area_mm2"]);
+  EXPECT_GT(std::abs(nlohmann::json::parse(plain.out)["plate"]["F_A"].get<double>() / 0.76 - 1), 0.1);
+  Result unknown = measure(R"(, "realization": "article")");
+  EXPECT_EQ(unknown.code, 2);
+  EXPECT_NE(unknown.err.find("realization"), std::string::npos) << unknown.err;
+  EXPECT_NE(unknown.err.find("default, paper"), std::string::npos) << unknown.err;
 }
 
 // `bcifs measure` of a bcifs_volume: the plain cube's 6^i cells and (1 - s^3)^i volumes, the lacunar cube's

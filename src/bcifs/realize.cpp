@@ -200,6 +200,25 @@ void validate(const GeometryOptions& options) {
   check(options.notch_depth, "notch_depth");
 }
 
+const std::vector<std::string>& realization_names() {
+  static const std::vector<std::string> names{"default", "paper"};
+  return names;
+}
+
+GeometryOptions realization_preset(const std::string& name) {
+  GeometryOptions options;
+  if (name == "default") return options;
+  if (name == "paper") {
+    options.lacuna_scale = 0.55;
+    options.gap_fraction = 0.2;
+    options.notch_depth = 0.7;
+    return options;
+  }
+  std::string known;
+  for (const std::string& n : realization_names()) known += (known.empty() ? "" : ", ") + n;
+  throw InvalidInput("unknown realization '" + name + "': expected one of " + known);
+}
+
 Vec2d vertex_position(const FaceRule& rule, const std::vector<Vec2d>& control, const VertexRef& vertex,
                       const GeometryOptions& options, const std::vector<Bend>& bends) {
   check_control(rule, control);

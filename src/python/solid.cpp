@@ -415,19 +415,19 @@ const char* kInputDocs[][2] = {
      "input solid), thickness_mm (2D)."},
     {"bcifs_plate",
      "A lacunar face (or assembly) as a plate: face or faces + shared, level (3), thickness_mm (1), radius_mm, "
-     "gap_fraction, lacuna_scale, notch_depth, origin_mm."},
+     "gap_fraction, lacuna_scale, notch_depth, realization (default, paper), origin_mm."},
     {"bcifs_cell",
      "A polyhedral cell with lacunar faces: cell (hexahedron, truncated_tetrahedron), edge_mm, thickness_mm, "
-     "center_mm, edge, params, algorithm, level (2), gap_fraction, lacuna_scale, notch_depth."},
+     "center_mm, edge, params, algorithm, level (2), gap_fraction, lacuna_scale, notch_depth, realization."},
     {"bcifs_volume",
      "Cells subdivided in 3D around lacunas: cell (hexahedron, tetrahedron, truncated_tetrahedron, prism), edge_mm, "
      "center_mm, delay, or corners_mm + faces, or cells (a list of those); walls (lacunar, plain), edge, params, "
      "algorithm, interior (lacunar, plain), radial, interior_params, interior_algorithm, level (2), lacuna_scale (0.5), "
-     "face_lacuna_scale, gap_fraction, notch_depth."},
+     "face_lacuna_scale, gap_fraction, notch_depth, realization."},
     {"bcifs_infill",
      "A hull filled with lacunar cells: hull (another input), skin_mm (1), cell_mm (10), level (2), equal_lacunas "
      "(true), grade (field, levels), walls, edge, params, algorithm, interior, radial, interior_params, interior_algorithm, lacuna_scale, "
-     "face_lacuna_scale, gap_fraction, notch_depth."},
+     "face_lacuna_scale, gap_fraction, notch_depth, realization."},
 };
 
 }  // namespace

@@ -88,6 +88,21 @@ double fraction(const JsonObject& o, const char* key, double fallback) {
   return v;
 }
 
+// The face geometry of an input: the named "realization" (default "default"), then any of its three options given
+// explicitly; `lacuna_key` names the key of the faces' lacuna scale.
+GeometryOptions face_geometry(const JsonObject& o, const char* lacuna_key = "lacuna_scale") {
+  GeometryOptions g;
+  try {
+    g = realization_preset(o.string_or("realization", "default"));
+  } catch (const InvalidInput& e) {
+    o.fail("realization", e.what());
+  }
+  g.gap_fraction = fraction(o, "gap_fraction", g.gap_fraction);
+  g.lacuna_scale = fraction(o, lacuna_key, g.lacuna_scale);
+  g.notch_depth = fraction(o, "notch_depth", g.notch_depth);
+  return g;
+}
+
 }  // namespace
 
 BcifsPlateInput parse_bcifs_plate_input(const JsonObject& o) {
@@ -139,9 +154,7 @@ BcifsPlateInput parse_bcifs_plate_input(const JsonObject& o) {
   spec.level = int(level);
   spec.thickness_mm = o.positive_length_or("thickness_mm", 1.0);
   spec.origin_mm = o.vec3_or("origin_mm", Vec3d{});
-  spec.options.defaults.gap_fraction = fraction(o, "gap_fraction", spec.options.defaults.gap_fraction);
-  spec.options.defaults.lacuna_scale = fraction(o, "lacuna_scale", spec.options.defaults.lacuna_scale);
-  spec.options.defaults.notch_depth = fraction(o, "notch_depth", spec.options.defaults.notch_depth);
+  spec.options.defaults = face_geometry(o);
   in.faces_listed = o.has("faces");
   return in;
 }
@@ -176,9 +189,7 @@ BcifsCellInput parse_bcifs_cell_input(const JsonObject& o) {
     o.fail("algorithm", e.what());
   }
   RealizeOptions& options = in.options;
-  options.defaults.gap_fraction = fraction(o, "gap_fraction", options.defaults.gap_fraction);
-  options.defaults.lacuna_scale = fraction(o, "lacuna_scale", options.defaults.lacuna_scale);
-  options.defaults.notch_depth = fraction(o, "notch_depth", options.defaults.notch_depth);
+  options.defaults = face_geometry(o);
   return in;
 }
 
@@ -266,9 +277,7 @@ VolumeKeys parse_volume_keys(const JsonObject& o, uint64_t max_level) {
   if (level > max_level) o.fail("level", "expected a level from 0 to " + std::to_string(max_level));
   k.level = int(level);
   k.options.lacuna_scale = fraction(o, "lacuna_scale", k.options.lacuna_scale);
-  k.options.faces.lacuna_scale = fraction(o, "face_lacuna_scale", k.options.faces.lacuna_scale);
-  k.options.faces.gap_fraction = fraction(o, "gap_fraction", k.options.faces.gap_fraction);
-  k.options.faces.notch_depth = fraction(o, "notch_depth", k.options.faces.notch_depth);
+  k.options.faces = face_geometry(o, "face_lacuna_scale");
   return k;
 }
 

@@ -179,6 +179,12 @@ def test_bcifs_plate_and_cell():
     near(m.volume_mm3, measured["area_mm2"][0] * 1.0, 0.01)
     cell = lacuna.bcifs_cell(cell="hexahedron", edge_mm=8, thickness_mm=1, level=1).mesh(voxel_size_mm=0.12)
     assert cell.components == 1 and cell.volume_mm3 > 0
+    # The "paper" realization: F0's published F_A 0.76, F_P 1.97 and D_box 1.65 within 3 %.
+    paper = lacuna.bcifs_measure(face={"boundary": "C2 B2 C2 B2 C2 B2"}, radius_mm=6, levels=(0, 5),
+                                 realization="paper")
+    near(paper["F_A"], 0.76, 0.03)
+    near(paper["F_P"], 1.97, 0.03)
+    near(paper["box_counting"]["region_dimension"], 1.65, 0.03)
 
 
 def test_bcifs_volume_opens_a_cube_into_a_handlebody():

@@ -390,6 +390,7 @@ def bcifs_plate(
     gap_fraction: float = ...,
     lacuna_scale: float = ...,
     notch_depth: float = ...,
+    realization: Literal["default", "paper"] = ...,
     origin_mm: _Vec3 = ...,
 ) -> Solid: ...
 def bcifs_cell(
@@ -405,6 +406,7 @@ def bcifs_cell(
     gap_fraction: float = ...,
     lacuna_scale: float = ...,
     notch_depth: float = ...,
+    realization: Literal["default", "paper"] = ...,
 ) -> Solid: ...
 def bcifs_volume(
     *,
@@ -428,6 +430,7 @@ def bcifs_volume(
     face_lacuna_scale: float = ...,
     gap_fraction: float = ...,
     notch_depth: float = ...,
+    realization: Literal["default", "paper"] = ...,
 ) -> Solid: ...
 def bcifs_infill(
     *,
@@ -449,6 +452,7 @@ def bcifs_infill(
     face_lacuna_scale: float = ...,
     gap_fraction: float = ...,
     notch_depth: float = ...,
+    realization: Literal["default", "paper"] = ...,
 ) -> Solid: ...
 
 # Generators.
