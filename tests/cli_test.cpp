@@ -616,6 +616,23 @@ TEST(Cli, CurvePointsAndFillRate) {
   Result bad_orders = lacuna("curve points --orders 3..1", dir.path());
   EXPECT_EQ(bad_orders.code, 2);
   EXPECT_NE(bad_orders.err.find("--orders"), std::string::npos) << bad_orders.err;
+  // --series: the superpositions H_(1..k), each the rate of its own run, and the fit of the union rates in the
+  // source's form (S_(1..5) at width 0.02: 1.72 e^(0.78 n) within 2 %); one order is not a series.
+  Result series = lacuna("curve fill-rate --series --kind sierpinski --orders 1..5 --width 0.02 --json", dir.path());
+  ASSERT_EQ(series.code, 0) << series.err;
+  const nlohmann::json sj = nlohmann::json::parse(series.out);
+  ASSERT_EQ(sj["series"].size(), 5u);
+  Result upto3 = lacuna("curve fill-rate --kind sierpinski --orders 1..3 --width 0.02 --json", dir.path());
+  ASSERT_EQ(upto3.code, 0) << upto3.err;
+  EXPECT_EQ(sj["series"][2]["fill_rate"], nlohmann::json::parse(upto3.out)["fill_rate"]);
+  EXPECT_NEAR(sj["fit_percent"]["exact"]["a"].get<double>() / 1.72, 1, 0.02);
+  EXPECT_NEAR(sj["fit_percent"]["exact"]["b"].get<double>() / 0.78, 1, 0.02);
+  Result one = lacuna("curve fill-rate --series --orders 4", dir.path());
+  EXPECT_EQ(one.code, 2);
+  EXPECT_NE(one.err.find("--orders"), std::string::npos) << one.err;
+  Result on_surface = lacuna("curve fill-rate --series --surface sphere", dir.path());
+  EXPECT_EQ(on_surface.code, 2);
+  EXPECT_NE(on_surface.err.find("--series"), std::string::npos) << on_surface.err;
 }
 
 TEST(Cli, FillPatternJsonSvgAndDeterminism) {

@@ -32,6 +32,7 @@ struct CurveArgs {
   bool surface_given = false;
   bool json = false;
   bool csv = false;
+  bool series = false;
 };
 
 std::vector<int> parse_orders(const std::string& text) {
@@ -142,7 +143,42 @@ int curve_surface_fill_rate(const CurveArgs& args) {
   return kExitOk;
 }
 
+// The growing superpositions of the orders and the exponential fits of their rates (the source's form).
+int curve_fill_rate_series(const CurveArgs& args) {
+  if (args.surface_given) throw InvalidInput("--series: measured in the square only (leave out --surface)");
+  if (!(args.width > 0)) throw InvalidInput("--width: expected a positive stroke width (the square has side 2)");
+  const std::vector<int> orders = parse_orders(args.orders);
+  FillRateSeries s;
+  try {
+    s = lacuna::curve_fill_rate_series(kind_of(args.kind), orders, args.width);
+  } catch (const InvalidInput& e) {
+    throw InvalidInput(std::string("--orders: ") + e.what());
+  }
+  if (args.json) {
+    nlohmann::json rows = nlohmann::json::array();
+    for (const CurveFillRate& r : s.rates)
+      rows.push_back({{"orders", r.orders}, {"segments", r.segments}, {"length", r.length}, {"fill_rate", r.fill_rate},
+                      {"fill_rate_simple", r.fill_rate_simple}});
+    std::cout << nlohmann::json{{"kind", args.kind},
+                                {"width", args.width},
+                                {"series", rows},
+                                {"fit_percent", {{"exact", {{"a", s.exact_fit.a}, {"b", s.exact_fit.b}}},
+                                                 {"simple", {{"a", s.simple_fit.a}, {"b", s.simple_fit.b}}}}}}
+                     .dump(2)
+              << "\n";
+    return kExitOk;
+  }
+  std::printf("%s, width %g: superpositions of orders %d..n\n", args.kind.c_str(), args.width, s.rates[0].orders[0]);
+  std::printf("%4s %12s %12s\n", "n", "union %", "simple %");
+  for (const CurveFillRate& r : s.rates)
+    std::printf("%4d %12.4f %12.4f\n", r.orders.back(), 100 * r.fill_rate, 100 * r.fill_rate_simple);
+  std::printf("fit (least squares of ln): union %.4g e^(%.4g n) %%, simple %.4g e^(%.4g n) %%\n", s.exact_fit.a,
+              s.exact_fit.b, s.simple_fit.a, s.simple_fit.b);
+  return kExitOk;
+}
+
 int curve_fill_rate(const CurveArgs& args) {
+  if (args.series) return curve_fill_rate_series(args);
   if (args.surface_given) return curve_surface_fill_rate(args);
   if (!(args.width > 0)) throw InvalidInput("--width: expected a positive stroke width (the square has side 2)");
   const CurveFillRate r = lacuna::curve_fill_rate(kind_of(args.kind), parse_orders(args.orders), args.width);
@@ -185,6 +221,9 @@ std::function<int()> add_curve_commands(CLI::App& app) {
                    "plane, sphere, cylinder, torus, cone, cube, bspline (--patch) or mesh (--mesh): the fraction of\n"
                    "the surface's area the tubes along the curves drawn on it cover (without it: the square's\n"
                    "strokes, exactly)");
+  fill->add_flag("--series", args->series,
+                 "The superpositions of the first k orders for every k, and exponential fits of their rates in\n"
+                 "percent against the highest order (a e^(b n), least squares of the logarithm)");
   fill->add_option("--samples", args->samples, "On a surface: integration cells per side (default: 8 across a tube)")
       ->check(CLI::Range(16, 20000));
   fill->add_option("--tolerance", args->tolerance, "On a surface: chord tolerance of the drawn curves")

@@ -200,6 +200,47 @@ CurveFillRate curve_fill_rate(curves::CurveKind kind, const std::vector<int>& or
   return r;
 }
 
+ExponentialFit exponential_fit(const std::vector<double>& x, const std::vector<double>& y) {
+  if (x.size() != y.size() || x.size() < 2) throw InvalidInput("an exponential fit needs two or more (x, y) points");
+  double mx = 0, my = 0;
+  for (size_t i = 0; i < x.size(); ++i) {
+    if (!(y[i] > 0) || !std::isfinite(y[i]) || !std::isfinite(x[i]))
+      throw InvalidInput("an exponential fit needs finite x and positive y, got y = " + message_number(y[i]));
+    mx += x[i];
+    my += std::log(y[i]);
+  }
+  mx /= double(x.size());
+  my /= double(x.size());
+  double sxy = 0, sxx = 0;
+  for (size_t i = 0; i < x.size(); ++i) {
+    sxy += (x[i] - mx) * (std::log(y[i]) - my);
+    sxx += (x[i] - mx) * (x[i] - mx);
+  }
+  if (!(sxx > 0)) throw InvalidInput("an exponential fit needs distinct x");
+  ExponentialFit f;
+  f.b = sxy / sxx;
+  f.a = std::exp(my - f.b * mx);
+  return f;
+}
+
+FillRateSeries curve_fill_rate_series(curves::CurveKind kind, const std::vector<int>& orders, double width) {
+  std::vector<int> sorted = orders;
+  std::sort(sorted.begin(), sorted.end());
+  sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
+  if (sorted.size() < 2) throw InvalidInput("a fill-rate series needs two or more orders");
+  FillRateSeries s;
+  std::vector<double> n, exact, simple;
+  for (size_t k = 1; k <= sorted.size(); ++k) {
+    s.rates.push_back(curve_fill_rate(kind, std::vector<int>(sorted.begin(), sorted.begin() + long(k)), width));
+    n.push_back(sorted[k - 1]);
+    exact.push_back(100 * s.rates.back().fill_rate);
+    simple.push_back(100 * s.rates.back().fill_rate_simple);
+  }
+  s.exact_fit = exponential_fit(n, exact);
+  s.simple_fit = exponential_fit(n, simple);
+  return s;
+}
+
 namespace {
 
 // The footprint of tubes of diameter `width` along the drawn curves on the surface the maps make up

@@ -87,6 +87,22 @@ struct CurveFillRate {
 // Throws InvalidInput unless width > 0.
 CurveFillRate curve_fill_rate(curves::CurveKind kind, const std::vector<int>& orders, double width);
 
+// y = a e^(b x), fitted by least squares to ln y (the form of the source's fill-rate fits).
+struct ExponentialFit {
+  double a = 0, b = 0;
+};
+// Throws InvalidInput unless there are at least two points, of equal count, with distinct x and every y > 0.
+ExponentialFit exponential_fit(const std::vector<double>& x, const std::vector<double>& y);
+
+// The growing superpositions of `orders` (n_1 < n_2 < ...): entry k is curve_fill_rate of n_1 .. n_k, and the
+// exponential fits of their rates in percent against n_k (the source fits 100 x rate = a e^(b n) for
+// H_(1,n) and S_(1,n)). Throws as curve_fill_rate, and InvalidInput for fewer than two orders.
+struct FillRateSeries {
+  std::vector<CurveFillRate> rates;
+  ExponentialFit exact_fit, simple_fit;  // of 100 fill_rate, 100 fill_rate_simple
+};
+FillRateSeries curve_fill_rate_series(curves::CurveKind kind, const std::vector<int>& orders, double width);
+
 // The fraction of a unit surface's area that tubes of diameter `width` along the curves drawn on it
 // (curve_points(), chords within `tolerance`) cover: curves::surface_coverage on samples x samples
 // cells of the square (each of the cube's six faces), rows in parallel, summed in order (identical for

@@ -330,6 +330,34 @@ void add_generators(py::module_& m) {
       "The fraction of the square (-1, 1)^2 covered by strokes of `width` (units of the square, side 2) along the "
       "curves: exactly (fill_rate, the union of the strokes) and simply (fill_rate_simple, length x width / 4).");
   m.def(
+      "curve_fill_rate_series",
+      [](const std::string& kind, const py::handle& orders, double width) {
+        const std::vector<int> o = orders_of(orders);
+        const curves::CurveKind k = kind_of(kind);
+        if (!(width > 0)) throw InvalidInput("width: expected a positive stroke width (the square has side 2)");
+        const FillRateSeries s = about("orders", [&] { return released([&] { return curve_fill_rate_series(k, o, width); }); });
+        py::list rows;
+        for (const CurveFillRate& r : s.rates) {
+          py::dict d;
+          d["orders"] = r.orders;
+          d["segments"] = r.segments;
+          d["length"] = r.length;
+          d["fill_rate"] = r.fill_rate;
+          d["fill_rate_simple"] = r.fill_rate_simple;
+          rows.append(d);
+        }
+        py::dict d;
+        d["kind"] = kind;
+        d["width"] = width;
+        d["series"] = rows;
+        d["fit_exact"] = py::make_tuple(s.exact_fit.a, s.exact_fit.b);
+        d["fit_simple"] = py::make_tuple(s.simple_fit.a, s.simple_fit.b);
+        return d;
+      },
+      py::arg("kind") = "hilbert", py::arg("orders") = "1..5", py::arg("width") = 0.02,
+      "The superpositions of the first k orders for every k (series: each as curve_fill_rate) and exponential fits "
+      "of their rates in percent against the highest order, 100 rate = a e^(b n) (fit_exact, fit_simple: (a, b)).");
+  m.def(
       "curve_surface_fill_rate",
       [](const std::string& kind, const py::handle& orders, double width, const std::string& surface,
          const py::object& patch, const py::object& mesh, int samples, double tolerance) {

@@ -471,6 +471,9 @@ def curve_points(
 def curve_fill_rate(
     kind: str = "hilbert", orders: Union[str, Sequence[int]] = "1..3", width: float = 0.02
 ) -> Dict[str, Any]: ...
+def curve_fill_rate_series(
+    kind: str = "hilbert", orders: Union[str, Sequence[int]] = "1..5", width: float = 0.02
+) -> Dict[str, Any]: ...
 def curve_surface_fill_rate(
     kind: str = "hilbert",
     orders: Union[str, Sequence[int]] = "1..3",
