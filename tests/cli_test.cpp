@@ -14,6 +14,7 @@
 
 #include "export/mesh_io.h"
 #include "fill/fill.h"
+#include "solids/components.h"
 #include "tests/test_support.h"
 #include <map>
 #include <regex>
@@ -424,6 +425,11 @@ std::vector<BadCase> bad_cases() {
           "period_mm": 10}}, "outputs": [{"of": "t", "file": "t.stl"}]})", "", "", "thickness_mm"},
       {"voronoi_foam_cover", R"({"inputs": {"f": {"type": "voronoi_foam", "points": [[0.1, 0.2, 0.3], [0.5, 0.5, 0.5]],
           "period_mm": 10, "wall_mm": 0.5, "cover": "nothing"}}, "outputs": [{"of": "f", "file": "f.stl"}]})", "", "", "nothing"},
+      {"voronoi_foam_refine_depth", R"({"inputs": {"f": {"type": "voronoi_foam", "points": [[0.1, 0.2, 0.3], [0.5, 0.5, 0.5]],
+          "period_mm": 10, "wall_mm": 0.5, "refine": {"field": "depth", "depth_mm": 2}}}, "outputs": [{"of": "f", "file": "f.stl"}]})", "", "", "inputs.f.refine.field"},
+      {"voronoi_foam_refine_levels", R"({"inputs": {"f": {"type": "voronoi_foam", "points": [[0.1, 0.2, 0.3], [0.5, 0.5, 0.5]],
+          "period_mm": 10, "wall_mm": 0.5, "refine": {"field": "ramp", "from_mm": 0, "to_mm": 10, "levels": 9}}},
+          "outputs": [{"of": "f", "file": "f.stl"}]})", "", "", "inputs.f.refine.levels"},
       {"not_json", "hello", "", "", "JSON"},
       {"trailing_comma", R"({"inputs": {}, })", "", "", "JSON"},
       {"top_level_array", "[1, 2]", "", "", "expected an object"},
@@ -820,6 +826,57 @@ TEST(Cli, VoronoiTilesPartitionThePeriod) {
 
 // `bcifs rules` on the note's examples; a plate's volume is its region's area (polygon formula) times its
 // thickness; `bcifs measure` gives N^C_i = 6^i for F0 and writes its two PNG files.
+// A foam refined where a ramp along x is high: the four fractal cells split into their children up to twice
+// towards x = 12 mm, each tile drawn with one level of detail. Inside a 0.6 mm skin the part is one solid (one
+// outward shell) whose closed cells (cavity shells) crowd where the field is high, many more of them than in
+// the unrefined foam of the same walls' level (3); every level keeps some tiles.
+TEST(Cli, VoronoiFoamRefinedWhereTheFieldIsHigh) {
+  TempDir dir;
+  auto recipe = [](const std::string& refine) {
+    return R"({"voxel_size_mm": 0.2, "inputs": {"foam": {"type": "voronoi_foam", "dimension": 3, "d": 2,
+        "points": [[0.12, 0.31, 0.77], [0.58, 0.22, 0.41], [0.36, 0.84, 0.18], [0.81, 0.63, 0.59]],
+        "period_mm": 12, "wall_mm": 0.5)" + refine + R"(},
+        "box": {"type": "box", "min_mm": [0, 0, 0], "max_mm": [12, 12, 12]}},
+        "operations": [{"name": "skin", "op": "shell", "of": "box", "thickness_mm": 0.6},
+          {"name": "inside", "op": "intersection", "of": ["box", "foam"]},
+          {"name": "part", "op": "union", "of": ["skin", "inside"]}],
+        "outputs": [{"of": "part", "file": "foam.stl"}]})";
+  };
+  struct Shells {
+    int bodies = 0, cavities = 0, high = 0;  // high: cavities centred at x > 6 mm
+  };
+  auto run = [&](const std::string& name, const std::string& refine, nlohmann::json* report) {
+    write_file(dir / (name + ".json"), recipe(refine));
+    Result r = lacuna("run " + quote((dir / (name + ".json")).string()) + " -o " + quote((dir / name).string()) + " --json",
+                      dir.path());
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(nlohmann::json::parse(r.out)["outputs"][0]["checks"]["valid"].get<bool>());
+    *report = nlohmann::json::parse(read_file(dir / name / "report.json"))["inputs"]["foam"];
+    Shells s;
+    for (const MeshComponent& c : mesh_components(read_mesh((dir / name / "foam.stl").string()))) {
+      if (c.signed_volume_mm3 > 0) ++s.bodies;
+      else {
+        ++s.cavities;
+        s.high += c.centroid_mm.x > 6;
+      }
+    }
+    return s;
+  };
+  nlohmann::json refined_report, plain_report;
+  const Shells refined = run("refined", R"(, "level": 1, "refine": {"field": "ramp", "axis": [1, 0, 0], "from_mm": 0,
+      "to_mm": 12, "levels": 2})", &refined_report);
+  const Shells plain = run("plain", R"(, "level": 3)", &plain_report);
+  EXPECT_EQ(refined.bodies, 1);
+  EXPECT_EQ(plain.bodies, 1);
+  ASSERT_EQ(refined_report["tiles_per_level"].size(), 3u);
+  for (const auto& t : refined_report["tiles_per_level"]) EXPECT_GT(t.get<int>(), 0);
+  EXPECT_FALSE(plain_report.contains("tiles_per_level"));
+  EXPECT_EQ(refined_report["points"], 4 * 8 * 8 * 8);  // generated to level 1 + 2
+  EXPECT_EQ(plain_report["points"], 4 * 8 * 8 * 8);
+  EXPECT_GT(refined.cavities, 3 * plain.cavities);
+  EXPECT_GT(refined.high, 2 * (refined.cavities - refined.high));
+}
+
 TEST(Cli, BcifsRulesPlateAndMeasure) {
   TempDir dir;
   Result f0 = lacuna("bcifs rules --boundary " + quote("C2 B2 C2 B2 C2 B2") + " --params " + quote("C2 B2 B2") + " --json",

@@ -480,6 +480,65 @@ TEST(VoronoiWalls, ShapeMethodMatchesClipping) {
   EXPECT_THROW(voronoi::extract_walls(shifted, voronoi::generate_level(shifted, 2)), InvalidInput);
 }
 
+// Refined tilings: a tile kept at level j is the union of the level-K cells of its generator's descendants, so
+// its measure is, from the rules alone, sum_i (M^(K-j))[shape][i] |V_i| / d^(nK) (|V_i| the level-0 cell of
+// p(i)); the tiles partition the torus; their walls (from the m cell shapes) equal those of clipping every cell.
+TEST(VoronoiRefine, TilesPartitionTheTorusAndMatchTheRuleCounts) {
+  for (const StartingSet& c : starting_sets(2, 1)) {
+    const Rules rules = voronoi::make_rules(c.n, 2, c.points, scaled());
+    const int detail = 1, levels = 2, last = detail + levels;
+    // Refine the half x < 1/2 fully, the quarter 1/2 <= x < 3/4 once.
+    const voronoi::RefinedLevel r = voronoi::refine_level(rules, detail, levels, [](const std::vector<double>& x, int l) {
+      return x[0] < 0.5 || (x[0] < 0.75 && l == 0);
+    });
+    const size_t m = rules.points.size();
+    const double dn = std::pow(2.0, c.n);
+    ASSERT_EQ(r.level.points.size(), size_t(std::pow(dn, last)) * m);
+    ASSERT_EQ(r.level.colour_count, int(r.tile_level.size()));
+    int kept = 0;
+    for (int t : r.tiles_per_level) kept += t;
+    EXPECT_EQ(kept, r.level.colour_count);
+    EXPECT_GT(r.tiles_per_level[2], 0);
+    EXPECT_LT(r.tiles_per_level[2], r.level.colour_count);  // not every tile refined to the end
+    const Level level0 = voronoi::generate_level(rules, 0);
+    const std::vector<double> cell0 = c.n == 2 ? voronoi::cell_measures_2d(level0) : voronoi::cell_measures_3d(level0);
+    const std::vector<double> tiles = c.n == 2 ? voronoi::cell_measures_2d(r.level) : voronoi::cell_measures_3d(r.level);
+    EXPECT_NEAR(std::accumulate(tiles.begin(), tiles.end(), 0.0), 1.0, 1e-9) << c.n;
+    std::vector<Eigen::MatrixXd> power(size_t(last) + 1, Eigen::MatrixXd::Identity(long(m), long(m)));
+    for (int t = 1; t <= last; ++t) power[size_t(t)] = power[size_t(t) - 1] * rules.matrix;
+    for (size_t t = 0; t < tiles.size(); ++t) {
+      const int steps = last - r.tile_level[t];
+      double expected = 0;
+      for (size_t i = 0; i < m; ++i) expected += power[size_t(steps)](r.tile_shape[t], long(i)) * cell0[i];
+      expected /= std::pow(dn, last);
+      EXPECT_NEAR(tiles[t], expected, 1e-12) << c.n << "D tile " << t;
+    }
+    // The tiles of each starting colour make up that colour's cell of the unrefined last level.
+    const Level plain = voronoi::generate_level(rules, last);
+    const std::vector<double> colours = c.n == 2 ? voronoi::cell_measures_2d(plain) : voronoi::cell_measures_3d(plain);
+    std::vector<double> by_colour(m, 0.0);
+    for (size_t t = 0; t < tiles.size(); ++t) by_colour[size_t(r.tile_colour[t])] += tiles[t];
+    for (size_t k = 0; k < m; ++k) EXPECT_NEAR(by_colour[k], colours[k], 1e-12) << c.n << "D colour " << k;
+    const voronoi::Walls fast = voronoi::extract_walls(rules, r.level);
+    const voronoi::Walls reference = voronoi::walls_by_clipping(r.level);
+    EXPECT_EQ(fast.facets.size(), reference.facets.size()) << c.n;
+    EXPECT_NEAR(fast.measure, reference.measure, 1e-9 * reference.measure) << c.n;
+  }
+  // Never refining gives the plain level detail + levels (the m fractal cells, the same walls); always refining
+  // gives one tile per generator of level `levels`, each drawn with `detail` more levels.
+  const Rules rules = voronoi::make_rules(2, 2, kExample, scaled());
+  const voronoi::RefinedLevel none = voronoi::refine_level(rules, 1, 2, [](const std::vector<double>&, int) { return false; });
+  const Level plain = voronoi::generate_level(rules, 3);
+  EXPECT_EQ(none.level.colours, plain.colours);
+  EXPECT_EQ(none.level.points, plain.points);
+  EXPECT_EQ(none.tiles_per_level, (std::vector<int>{3, 0, 0}));
+  EXPECT_EQ(voronoi::extract_walls(rules, none.level).measure, voronoi::extract_walls(rules, plain).measure);
+  const voronoi::RefinedLevel all = voronoi::refine_level(rules, 1, 2, [](const std::vector<double>&, int) { return true; });
+  EXPECT_EQ(all.level.colour_count, 3 * 16);
+  EXPECT_EQ(all.tiles_per_level, (std::vector<int>{0, 0, 3 * 16}));
+  EXPECT_THROW(voronoi::refine_level(rules, -1, 1, [](const std::vector<double>&, int) { return false; }), InvalidInput);
+}
+
 // Without a gap the compact tiles hold exactly the cell measure of their colour, and together a fundamental
 // domain of the torus (measure 1); with a gap, tiles + gap (wall measure x width) still make 1 up to the
 // corners where walls meet.

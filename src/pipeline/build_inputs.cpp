@@ -433,6 +433,11 @@ class Builder {
     return part;
   }
 
+  static VoronoiPartition with_level(VoronoiPartition p, int level) {
+    p.level = level;
+    return p;
+  }
+
   // A keep-flag per colour: the 1-based colours listed, or every one.
   static std::vector<char> kept(const std::vector<int>& colours, size_t m) {
     std::vector<char> keep(m, colours.empty() ? 1 : 0);
@@ -494,9 +499,30 @@ class Builder {
 
   // Foam: the walls between colours thickened, repeated over whole periods (clip it with an intersection).
   void add(const VoronoiFoamInput& v) {
-    Partition part = partition(v.partition, false);
+    Partition part = partition(v.refine_levels ? with_level(v.partition, 0) : v.partition, false);
+    std::vector<int> tiles_per_level;
+    if (v.refine_levels) {
+      // The partition's fractal cells, each replaced by its children while the field at its generator asks for
+      // it, every tile drawn with `level` levels of detail.
+      const voronoi::TorusPlacement& place = part.place;
+      const GradeField& field = v.refine;
+      const int levels = v.refine_levels;
+      try {
+        voronoi::RefinedLevel refined = voronoi::refine_level(
+            part.rules, v.partition.level, levels, [&](const std::vector<double>& x, int l) {
+              const Vec3d p = place.to_mm(x[0], x[1], place.dimension == 3 ? x[2] : 0.0);
+              return field.at(p) > double(l + 1) / double(levels + 1);
+            });
+        part.level = std::move(refined.level);
+        tiles_per_level = std::move(refined.tiles_per_level);
+      } catch (const ResourceLimit& e) {
+        throw ResourceLimit(where() + ".refine: " + e.what());
+      }
+    }
     const voronoi::Walls walls = voronoi::extract_walls(part.rules, part.level);
-    out_.report = walls_report(part, walls);
+    VoronoiWallsReport report = walls_report(part, walls);
+    report.tiles_per_level = tiles_per_level;
+    out_.report = report;
     part.level = voronoi::Level();  // the walls are all that is needed from here on
     const voronoi::TorusPlacement& place = part.place;
     if (!v.cover) {

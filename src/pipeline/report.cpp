@@ -77,6 +77,7 @@ nlohmann::json to_json(const InputReport& report) {
                                 {r.dimension == 2 ? "wall_length_mm" : "wall_area_mm2", r.wall_measure}};
             if (r.pieces) j["pieces"] = *r.pieces;
             if (r.clearance_mm) j["clearance_mm"] = *r.clearance_mm;
+            if (!r.tiles_per_level.empty()) j["tiles_per_level"] = r.tiles_per_level;
             return j;
           },
           [](const BcifsPlateReport& r) {

@@ -412,7 +412,8 @@ const char* kInputDocs[][2] = {
      "The fractal Voronoi tiles of the kept colours: the partition keys, colours, clearance_mm, thickness_mm (2D)."},
     {"voronoi_foam",
      "The walls between colours of a fractal Voronoi level, thickened: the partition keys, wall_mm, tiles or cover (an "
-     "input solid), thickness_mm (2D)."},
+     "input solid), thickness_mm (2D), refine (field ramp or points with its keys, levels: tiles split into their "
+     "children where the field is high)."},
     {"bcifs_plate",
      "A lacunar face (or assembly) as a plate: face or faces + shared, level (3), thickness_mm (1), radius_mm, "
      "gap_fraction, lacuna_scale, notch_depth, realization (default, paper), origin_mm."},

@@ -203,6 +203,11 @@ struct VoronoiFoamInput {
   double thickness_mm = 0;            // 2D: the plate's thickness
   std::array<int, 3> tiles{1, 1, 1};  // periods along each axis, without `cover`
   std::optional<std::string> cover;   // instead of tiles: every period meeting that input's box
+  // `refine`: starting from the partition's fractal cells, a tile of level l < refine_levels is replaced by its
+  // children while the field at its generator (mm, the period at origin_mm) exceeds (l + 1) / (refine_levels + 1);
+  // every tile drawn with `level` levels of detail (walls of level + refine_levels). kind kNone: no refinement.
+  GradeField refine;
+  int refine_levels = 0;
 };
 
 // "bcifs_plate": a lacunar face, or an assembly of faces, extruded into a plate.

@@ -106,6 +106,15 @@ VoronoiFoamInput parse_voronoi_foam_input(const JsonObject& o) {
   if (o.has("tiles") && o.has("cover")) o.fail("cover", "give \"tiles\" or \"cover\", not both");
   if (o.has("cover")) in.cover = o.string("cover");
   else in.tiles = parse_tiles(o, in.partition.dimension);
+  if (o.has("refine")) {
+    const JsonObject r = o.object("refine");
+    r.allow_only({"field", "axis", "from_mm", "to_mm", "points_mm", "falloff_mm", "depth_mm", "levels"});
+    if (r.string("field") == "depth") r.fail("field", "a foam has no hull to measure depth in: use \"ramp\" or \"points\"");
+    in.refine = parse_grade_field(r, "");
+    const uint64_t levels = r.unsigned_integer_or("levels", 1);
+    if (levels < 1 || levels > 6) r.fail("levels", "expected 1 to 6 refinement levels");
+    in.refine_levels = int(levels);
+  }
   return in;
 }
 

@@ -74,7 +74,7 @@ const std::map<std::string, InputType>& types() {
               parse_as<VoronoiSpheresInput, parse_voronoi_spheres_input>},
              {"voronoi_tiles", voronoi_keys({"colours", "clearance_mm", "thickness_mm"}),
               parse_as<VoronoiTilesInput, parse_voronoi_tiles_input>},
-             {"voronoi_foam", voronoi_keys({"wall_mm", "tiles", "cover", "thickness_mm"}),
+             {"voronoi_foam", voronoi_keys({"wall_mm", "tiles", "cover", "thickness_mm", "refine"}),
               parse_as<VoronoiFoamInput, parse_voronoi_foam_input>},
              {"bcifs_plate",
               {"face", "faces", "shared", "level", "thickness_mm", "radius_mm", "gap_fraction", "lacuna_scale", "notch_depth",

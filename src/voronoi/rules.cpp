@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -406,6 +407,69 @@ Level generate_level(const Rules& rules, int k, bool keep_unwrapped) {
   for (size_t c = 0; c < rules.points.size(); ++c)
     sub(rules, 0, k, int(c), int(c), rules.points[c], scale, keep_unwrapped, level);
   return level;
+}
+
+namespace {
+
+struct Refiner {
+  const Rules& rules;
+  int levels, last;
+  const std::function<bool(const std::vector<double>&, int)>& refine;
+  std::vector<double> scale;
+  RefinedLevel out;
+
+  // The node of level i at p (unwrapped), following rule c, of starting colour s, in tile `tile` (-1: refined
+  // so far, not yet a tile).
+  void visit(int i, int s, int c, const std::vector<double>& p, int tile) {
+    if (tile < 0) {
+      std::vector<double> x(p.size());
+      for (size_t j = 0; j < p.size(); ++j) x[j] = wrap(p[j]);
+      if (i == levels || !refine(x, i)) {
+        tile = int(out.tile_level.size());
+        out.tile_level.push_back(i);
+        out.tile_shape.push_back(c);
+        out.tile_colour.push_back(s);
+        ++out.tiles_per_level[size_t(i)];
+      }
+    }
+    if (i < last) {
+      std::vector<double> child(p.size());
+      for (const Rule& rule : rules.rules[size_t(c)]) {
+        for (size_t j = 0; j < p.size(); ++j) child[j] = p[j] + rule.offset[j] * scale[size_t(i)];
+        visit(i + 1, s, rule.follows, child, tile);
+      }
+      return;
+    }
+    std::vector<double> q(p.size());
+    for (size_t j = 0; j < p.size(); ++j) q[j] = wrap(p[j]);
+    out.level.points.push_back(std::move(q));
+    out.level.colours.push_back(tile);
+    out.level.shapes.push_back(c);
+  }
+};
+
+}  // namespace
+
+RefinedLevel refine_level(const Rules& rules, int detail, int levels,
+                          const std::function<bool(const std::vector<double>& x, int l)>& refine) {
+  if (detail < 0 || levels < 0)
+    throw InvalidInput("voronoi: a refined level needs detail >= 0 and levels >= 0, got " + std::to_string(detail) +
+                       " and " + std::to_string(levels));
+  const int last = detail + levels;
+  const double count = std::pow(std::pow(double(rules.d), rules.dimension), last) * double(rules.points.size());
+  if (count > kMaxLevelPoints)
+    throw ResourceLimit("voronoi: level " + std::to_string(last) + " would hold " + std::to_string(count) +
+                        " points, more than the limit of 20000000; use a lower level or fewer refinement levels");
+  Refiner r{rules, levels, last, refine, std::vector<double>(size_t(last) + 1, 1.0), {}};
+  for (int i = 1; i <= last; ++i) r.scale[size_t(i)] = r.scale[size_t(i) - 1] / rules.d;
+  r.out.tiles_per_level.assign(size_t(levels) + 1, 0);
+  r.out.level.dimension = rules.dimension;
+  r.out.level.points.reserve(size_t(count));
+  r.out.level.colours.reserve(size_t(count));
+  r.out.level.shapes.reserve(size_t(count));
+  for (size_t c = 0; c < rules.points.size(); ++c) r.visit(0, int(c), int(c), rules.points[c], -1);
+  r.out.level.colour_count = int(r.out.tile_level.size());
+  return r.out;
 }
 
 std::vector<double> cell_measures_2d(const Level& level) { return scan_cells(level, 2, false).measures; }

@@ -7,6 +7,7 @@
 #include <Eigen/Dense>
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <utility>
 #include <vector>
 
@@ -79,6 +80,26 @@ struct Level {
 // P^k by the spec's recursion Sub: (d^n)^k m points. Throws InvalidInput for k < 0 and ResourceLimit when
 // the level would hold more than 20 000 000 points.
 Level generate_level(const Rules& rules, int k, bool keep_unwrapped = false);
+
+// A tiling of non-uniform density (quasi-periodic tilings: every tile is the union of its children, the
+// tiles of the next level scaled by 1/d). A point of P^l carries one tile of level l, the union of the cells
+// of its descendants; the tiles of level 0 are the partition's m fractal cells. Starting from them, a tile of
+// level l < levels is replaced by its children while refine(x, l) says so, x the tile's generator (wrapped
+// into [0,1)^n). Every tile is drawn with `detail` more levels, so the level is generated to detail + levels
+// with scaled children, and each of its points is coloured by the tile it ends in: `level.colours` are tile
+// indices (colour_count the number of tiles, in the order of the spec's recursion), so walls between colours
+// are the walls between tiles, closed across every change of resolution because all of them are faces of one
+// Voronoi diagram. Never refining gives generate_level(rules, detail + levels) itself. Throws InvalidInput
+// for detail < 0 or levels < 0 and ResourceLimit as generate_level.
+struct RefinedLevel {
+  Level level;
+  std::vector<int> tile_level;       // per tile: the level it was kept at (0 .. levels)
+  std::vector<int> tile_shape;       // per tile: the starting point whose rule its generator follows
+  std::vector<int> tile_colour;      // per tile: its starting colour (the level-0 tile it lies in)
+  std::vector<int> tiles_per_level;  // how many tiles were kept at each level 0 .. levels
+};
+RefinedLevel refine_level(const Rules& rules, int detail, int levels,
+                          const std::function<bool(const std::vector<double>& x, int l)>& refine);
 
 // The measure of each colour's union of periodic Voronoi cells at a 2D level, exactly (each cell is the
 // torus square around its generator clipped by the bisectors of every generator copy that can reach it), so

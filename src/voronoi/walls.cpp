@@ -41,9 +41,11 @@ int64_t modulo(int64_t a, int64_t b) { return ((a % b) + b) % b; }
 Lattice make_lattice(const Rules& rules, const Level& level) {
   const int n = rules.dimension;
   const size_t m = rules.points.size();
-  if (level.dimension != n || level.colour_count != int(m) || level.shapes.size() != level.points.size() ||
-      level.colours.size() != level.points.size())
-    throw InvalidInput("voronoi walls: the level was not generated from these rules");
+  // Colours need not be the starting points' (a refined level colours by tile); shapes must be.
+  bool shapes_ok = level.dimension == n && level.shapes.size() == level.points.size() &&
+                   level.colours.size() == level.points.size();
+  for (size_t i = 0; shapes_ok && i < level.shapes.size(); ++i) shapes_ok = level.shapes[i] >= 0 && size_t(level.shapes[i]) < m;
+  if (!shapes_ok) throw InvalidInput("voronoi walls: the level was not generated from these rules");
   Lattice lattice;
   lattice.n = n;
   // |P^k| = m (d^n)^k: find D = d^k.

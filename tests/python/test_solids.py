@@ -171,6 +171,22 @@ def test_voronoi_foam_is_walls():
     assert m.components >= 1 and m.volume_mm3 > 0
 
 
+def test_voronoi_foam_refined_where_the_field_asks():
+    # A field that never passes the threshold leaves the two fractal cells whole: the walls of level 1 + 2, the
+    # same mesh as the plain foam of level 3. A field that refines everywhere adds the walls between the tiles.
+    keys = dict(dimension=3, d=2, points=[[0.1, 0.2, 0.3], [0.6, 0.7, 0.2]], period_mm=8, wall_mm=0.4)
+    box = lacuna.box(min_mm=[0.5, 0.5, 0.5], max_mm=[7.5, 7.5, 7.5])
+    plain = (lacuna.voronoi_foam(level=3, **keys) & box).mesh(voxel_size_mm=0.2)
+    never = dict(field="ramp", axis=[1, 0, 0], from_mm=100, to_mm=200, levels=2)
+    same = (lacuna.voronoi_foam(level=1, refine=never, **keys) & box).mesh(voxel_size_mm=0.2)
+    assert len(same.faces) == len(plain.faces) and same.volume_mm3 == plain.volume_mm3
+    always = dict(field="ramp", axis=[1, 0, 0], from_mm=-200, to_mm=-100, levels=2)
+    dense = (lacuna.voronoi_foam(level=1, refine=always, **keys) & box).mesh(voxel_size_mm=0.2)
+    assert dense.volume_mm3 > 1.5 * plain.volume_mm3
+    with pytest.raises(ValueError, match="refine"):
+        lacuna.voronoi_foam(level=1, refine=dict(field="depth", depth_mm=1), **keys)
+
+
 def test_bcifs_plate_and_cell():
     # The plate is its level's region (what bcifs_measure measures) extruded by its thickness.
     plate = lacuna.bcifs_plate(face={"boundary": "C2 B2 C2 B2 C2 B2"}, radius_mm=6, level=1, thickness_mm=1)

@@ -378,6 +378,7 @@ def voronoi_foam(
     tiles: Sequence[int] = ...,
     cover: Solid = ...,
     thickness_mm: float = ...,
+    refine: Mapping[str, Any] = ...,
 ) -> Solid: ...
 def bcifs_plate(
     *,
