@@ -12,6 +12,23 @@
 namespace lacuna {
 namespace test {
 
+// The triangles of a (cells + 1) x (cells + 1) vertex grid, vertex (i, j) at j * (cells + 1) + i: each cell
+// split in two with diagonals alternating, counter-clockwise when i runs along +x and j along +y.
+inline void append_grid_triangles(TriMesh& mesh, int cells) {
+  auto at = [&](int i, int j) { return uint32_t(j * (cells + 1) + i); };
+  for (int j = 0; j < cells; ++j)
+    for (int i = 0; i < cells; ++i) {
+      const uint32_t a = at(i, j), b = at(i + 1, j), c = at(i + 1, j + 1), d = at(i, j + 1);
+      if ((i + j) % 2 == 0) {
+        mesh.triangles.push_back({a, b, c});
+        mesh.triangles.push_back({a, c, d});
+      } else {
+        mesh.triangles.push_back({a, b, d});
+        mesh.triangles.push_back({b, c, d});
+      }
+    }
+}
+
 // An octahedron subdivided `levels` times and pushed onto the sphere of radius r about c: closed,
 // outward, 8 * 4^levels triangles.
 inline TriMesh geodesic_sphere(const Vec3d& c, double r, int levels) {

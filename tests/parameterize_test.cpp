@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "errors.h"
+#include "mesh_fixtures.h"
 
 namespace lacuna {
 namespace {
@@ -47,19 +48,7 @@ TriMesh grid_patch(int cells, double side) {
       mesh.positions_mm.push_back({i * h + dx, j * h + dy, 0});
     }
   }
-  auto at = [&](int i, int j) { return uint32_t(j * (cells + 1) + i); };
-  for (int j = 0; j < cells; ++j) {
-    for (int i = 0; i < cells; ++i) {
-      uint32_t a = at(i, j), b = at(i + 1, j), c = at(i + 1, j + 1), d = at(i, j + 1);
-      if ((i + j) % 2 == 0) {
-        mesh.triangles.push_back({a, b, c});
-        mesh.triangles.push_back({a, c, d});
-      } else {
-        mesh.triangles.push_back({a, b, d});
-        mesh.triangles.push_back({b, c, d});
-      }
-    }
-  }
+  test::append_grid_triangles(mesh, cells);
   return mesh;
 }
 

@@ -11,6 +11,7 @@
 #include "errors.h"
 #include "pipeline/generators.h"
 #include "solids/parameterize.h"
+#include "mesh_fixtures.h"
 
 namespace lacuna {
 namespace {
@@ -96,18 +97,7 @@ TEST(SurfaceFillRate, OnAFlatMeshPatchItIsThePlanarUnionOfTheDrawnCurves) {
       const double dy = inner ? 0.2 / cells * std::cos(39.3468 * i + 11.135 * j) : 0;
       mesh.positions_mm.push_back({-half + i * step + dx, y + dy, 0});
     }
-  auto at = [&](int i, int j) { return uint32_t(j * (cells + 1) + i); };
-  for (int j = 0; j < cells; ++j)
-    for (int i = 0; i < cells; ++i) {
-      const uint32_t a = at(i, j), b = at(i + 1, j), c = at(i + 1, j + 1), d = at(i, j + 1);
-      if ((i + j) % 2 == 0) {
-        mesh.triangles.push_back({a, b, c});
-        mesh.triangles.push_back({a, c, d});
-      } else {
-        mesh.triangles.push_back({a, b, d});
-        mesh.triangles.push_back({b, c, d});
-      }
-    }
+  test::append_grid_triangles(mesh, cells);
   const curves::SurfaceMap map = mesh_patch_map(mesh, "trapezoid");
   const double width = 0.06, r = width / 2;
   const std::vector<int> orders{2, 3};

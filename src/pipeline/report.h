@@ -54,7 +54,7 @@ struct VoronoiWallsReport {
   double wall_measure = 0;            // wall length (2D, mm) or area (3D, mm^2) in one period
   std::optional<size_t> pieces;       // tiles: convex pieces
   std::optional<double> clearance_mm; // tiles: the gap between colours
-  std::vector<int> tiles_per_level;   // foam with `refine`: tiles kept at each level, from `level` up
+  std::vector<int> tiles_per_level;   // foam with `refine`: tiles kept at each refinement level 0 .. refine levels
 };
 
 // One face of a lacunar plate at its level.

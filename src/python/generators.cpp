@@ -69,6 +69,17 @@ CurveSurface surface_of(const std::string& surface) {
   throw InvalidInput("surface: expected plane, sphere, cylinder, torus, cone or cube, got \"" + surface + "\"");
 }
 
+// A curve fill rate as the Python functions give it (curve_fill_rate and each row of curve_fill_rate_series).
+py::dict fill_rate_dict(const CurveFillRate& r) {
+  py::dict d;
+  d["orders"] = r.orders;
+  d["segments"] = r.segments;
+  d["length"] = r.length;
+  d["fill_rate"] = r.fill_rate;
+  d["fill_rate_simple"] = r.fill_rate_simple;
+  return d;
+}
+
 py::array_t<double> matrix_array(const Eigen::MatrixXd& m) {
   py::array_t<double> a({py::ssize_t(m.rows()), py::ssize_t(m.cols())});
   for (Eigen::Index i = 0; i < m.rows(); ++i)
@@ -316,14 +327,9 @@ void add_generators(py::module_& m) {
         const std::vector<int> o = orders_of(orders);
         const curves::CurveKind k = kind_of(kind);
         const CurveFillRate r = about("width", [&] { return released([&] { return curve_fill_rate(k, o, width); }); });
-        py::dict d;
+        py::dict d = fill_rate_dict(r);
         d["kind"] = kind;
-        d["orders"] = r.orders;
         d["width"] = width;
-        d["segments"] = r.segments;
-        d["length"] = r.length;
-        d["fill_rate"] = r.fill_rate;
-        d["fill_rate_simple"] = r.fill_rate_simple;
         return d;
       },
       py::arg("kind") = "hilbert", py::arg("orders") = "1..3", py::arg("width") = 0.02,
@@ -338,13 +344,7 @@ void add_generators(py::module_& m) {
         const FillRateSeries s = about("orders", [&] { return released([&] { return curve_fill_rate_series(k, o, width); }); });
         py::list rows;
         for (const CurveFillRate& r : s.rates) {
-          py::dict d;
-          d["orders"] = r.orders;
-          d["segments"] = r.segments;
-          d["length"] = r.length;
-          d["fill_rate"] = r.fill_rate;
-          d["fill_rate_simple"] = r.fill_rate_simple;
-          rows.append(d);
+          rows.append(fill_rate_dict(r));
         }
         py::dict d;
         d["kind"] = kind;

@@ -276,24 +276,6 @@ Level level_zero(const Rules& rules) {
   return level;
 }
 
-void sub(const Rules& rules, int i, int k, int s, int c, const std::vector<double>& p, const std::vector<double>& scale,
-         bool keep_unwrapped, Level& level) {
-  if (i < k) {
-    std::vector<double> child(p.size());
-    for (const Rule& rule : rules.rules[size_t(c)]) {
-      for (size_t j = 0; j < p.size(); ++j) child[j] = p[j] + rule.offset[j] * scale[size_t(i)];
-      sub(rules, i + 1, k, s, rule.follows, child, scale, keep_unwrapped, level);
-    }
-    return;
-  }
-  std::vector<double> q(p.size());
-  for (size_t j = 0; j < p.size(); ++j) q[j] = wrap(p[j]);
-  level.points.push_back(std::move(q));
-  level.colours.push_back(s);
-  level.shapes.push_back(c);
-  if (keep_unwrapped) level.unwrapped.push_back(p);
-}
-
 }  // namespace
 
 double torus_distance_squared(const std::vector<double>& p, const std::vector<double>& q) {
@@ -387,34 +369,16 @@ std::vector<std::vector<double>> random_points(int n, int m, uint64_t seed) {
   return points;
 }
 
-Level generate_level(const Rules& rules, int k, bool keep_unwrapped) {
-  if (k < 0) throw InvalidInput("voronoi: the level must be >= 0, got " + std::to_string(k));
-  const double dn = std::pow(double(rules.d), rules.dimension);
-  const double count = std::pow(dn, k) * double(rules.points.size());
-  if (count > kMaxLevelPoints)
-    throw ResourceLimit("voronoi: level " + std::to_string(k) + " would hold " + std::to_string(count) +
-                        " points, more than the limit of 20000000; use a lower level");
-  std::vector<double> scale(size_t(k) + 1, 1.0);
-  for (int i = 1; i <= k; ++i) scale[size_t(i)] = scale[size_t(i) - 1] / rules.d;  // powers of d: exact enough
-  Level level = level_zero(rules);
-  level.points.clear();
-  level.colours.clear();
-  level.shapes.clear();
-  level.points.reserve(size_t(count));
-  level.colours.reserve(size_t(count));
-  level.shapes.reserve(size_t(count));
-  if (keep_unwrapped) level.unwrapped.reserve(size_t(count));
-  for (size_t c = 0; c < rules.points.size(); ++c)
-    sub(rules, 0, k, int(c), int(c), rules.points[c], scale, keep_unwrapped, level);
-  return level;
-}
-
 namespace {
 
+// The Sub recursion of the spec, refining selectively: a node of level i is kept as a tile when i == levels or
+// refine(x, i) is false (levels = 0: every starting point is one tile and its colour, the plain level), and
+// every tile's generators are its descendants at level `last`, coloured by the tile.
 struct Refiner {
   const Rules& rules;
   int levels, last;
-  const std::function<bool(const std::vector<double>&, int)>& refine;
+  const std::function<bool(const std::vector<double>&, int)>* refine;  // null when levels == 0
+  bool keep_unwrapped;
   std::vector<double> scale;
   RefinedLevel out;
 
@@ -424,7 +388,7 @@ struct Refiner {
     if (tile < 0) {
       std::vector<double> x(p.size());
       for (size_t j = 0; j < p.size(); ++j) x[j] = wrap(p[j]);
-      if (i == levels || !refine(x, i)) {
+      if (i == levels || !(*refine)(x, i)) {
         tile = int(out.tile_level.size());
         out.tile_level.push_back(i);
         out.tile_shape.push_back(c);
@@ -445,31 +409,44 @@ struct Refiner {
     out.level.points.push_back(std::move(q));
     out.level.colours.push_back(tile);
     out.level.shapes.push_back(c);
+    if (keep_unwrapped) out.level.unwrapped.push_back(p);
   }
 };
 
+RefinedLevel refined(const Rules& rules, int detail, int levels,
+                     const std::function<bool(const std::vector<double>&, int)>* refine, bool keep_unwrapped) {
+  const int last = detail + levels;
+  const double count = std::pow(std::pow(double(rules.d), rules.dimension), last) * double(rules.points.size());
+  if (count > kMaxLevelPoints)
+    throw ResourceLimit("voronoi: level " + std::to_string(last) + " would hold " + std::to_string(count) +
+                        " points, more than the limit of 20000000; use a lower level" +
+                        (levels > 0 ? " or fewer refinement levels" : ""));
+  Refiner r{rules, levels, last, refine, keep_unwrapped, std::vector<double>(size_t(last) + 1, 1.0), {}};
+  for (int i = 1; i <= last; ++i) r.scale[size_t(i)] = r.scale[size_t(i) - 1] / rules.d;  // powers of d: exact enough
+  r.out.tiles_per_level.assign(size_t(levels) + 1, 0);
+  r.out.level.dimension = rules.dimension;
+  r.out.level.points.reserve(size_t(count));
+  r.out.level.colours.reserve(size_t(count));
+  r.out.level.shapes.reserve(size_t(count));
+  if (keep_unwrapped) r.out.level.unwrapped.reserve(size_t(count));
+  for (size_t c = 0; c < rules.points.size(); ++c) r.visit(0, int(c), int(c), rules.points[c], -1);
+  r.out.level.colour_count = int(r.out.tile_level.size());
+  return r.out;
+}
+
 }  // namespace
+
+Level generate_level(const Rules& rules, int k, bool keep_unwrapped) {
+  if (k < 0) throw InvalidInput("voronoi: the level must be >= 0, got " + std::to_string(k));
+  return refined(rules, k, 0, nullptr, keep_unwrapped).level;
+}
 
 RefinedLevel refine_level(const Rules& rules, int detail, int levels,
                           const std::function<bool(const std::vector<double>& x, int l)>& refine) {
   if (detail < 0 || levels < 0)
     throw InvalidInput("voronoi: a refined level needs detail >= 0 and levels >= 0, got " + std::to_string(detail) +
                        " and " + std::to_string(levels));
-  const int last = detail + levels;
-  const double count = std::pow(std::pow(double(rules.d), rules.dimension), last) * double(rules.points.size());
-  if (count > kMaxLevelPoints)
-    throw ResourceLimit("voronoi: level " + std::to_string(last) + " would hold " + std::to_string(count) +
-                        " points, more than the limit of 20000000; use a lower level or fewer refinement levels");
-  Refiner r{rules, levels, last, refine, std::vector<double>(size_t(last) + 1, 1.0), {}};
-  for (int i = 1; i <= last; ++i) r.scale[size_t(i)] = r.scale[size_t(i) - 1] / rules.d;
-  r.out.tiles_per_level.assign(size_t(levels) + 1, 0);
-  r.out.level.dimension = rules.dimension;
-  r.out.level.points.reserve(size_t(count));
-  r.out.level.colours.reserve(size_t(count));
-  r.out.level.shapes.reserve(size_t(count));
-  for (size_t c = 0; c < rules.points.size(); ++c) r.visit(0, int(c), int(c), rules.points[c], -1);
-  r.out.level.colour_count = int(r.out.tile_level.size());
-  return r.out;
+  return refined(rules, detail, levels, &refine, false);
 }
 
 std::vector<double> cell_measures_2d(const Level& level) { return scan_cells(level, 2, false).measures; }
