@@ -52,9 +52,11 @@ void write_3mf(const std::string& path, const TriMesh& mesh, const ThreeMfInfo& 
 struct ThreeMfObject {
   const TriMesh* mesh = nullptr;
   std::string name;
+  std::string display_color;  // "#rrggbb": the object's base material shows it (multi-material); empty: none
 };
 
-// The same with one mesh object and one build item per part, in order (info.object_name unused).
+// The same with one mesh object and one build item per part, in order (info.object_name unused). Parts
+// with a display colour reference one base material each of a <basematerials> group (3MF core).
 void write_3mf(const std::string& path, const std::vector<ThreeMfObject>& parts, const ThreeMfInfo& info);
 
 }  // namespace lacuna

@@ -3,6 +3,7 @@
 
 #include <zip.h>
 
+#include <cctype>
 #include <charconv>
 
 #include <algorithm>
@@ -629,7 +630,7 @@ TriMesh read_3mf(const std::string& path, const ReadOptions& options) {
 }
 
 void write_3mf(const std::string& path, const TriMesh& mesh, const ThreeMfInfo& info) {
-  write_3mf(path, std::vector<ThreeMfObject>{{&mesh, info.object_name}}, info);
+  write_3mf(path, std::vector<ThreeMfObject>{{&mesh, info.object_name, ""}}, info);
 }
 
 void write_3mf(const std::string& path, const std::vector<ThreeMfObject>& parts, const ThreeMfInfo& info) {
@@ -667,6 +668,10 @@ void write_3mf(const std::string& path, const std::vector<ThreeMfObject>& parts,
       }
     }
     if (has_control_character(part.name)) invalid("an object name contains a control character");
+    const std::string& c = part.display_color;
+    if (!c.empty() && (c.size() != 7 || c[0] != '#' ||
+                       !std::all_of(c.begin() + 1, c.end(), [](char h) { return std::isxdigit(static_cast<unsigned char>(h)); })))
+      invalid(cat("the display colour of '", part.name, "' is \"", c, "\", expected #rrggbb"));
     all_vertices.push_back(std::move(vertices));
     all_triangles.push_back(std::move(triangles));
   }
@@ -690,6 +695,7 @@ void write_3mf(const std::string& path, const std::vector<ThreeMfObject>& parts,
     hash = fnv1a(hash, all_vertices[i].data(), all_vertices[i].size() * sizeof(NMR::MODELMESHVERTEX));
     hash = fnv1a(hash, all_triangles[i].data(), all_triangles[i].size() * sizeof(NMR::MODELMESHTRIANGLE));
     hash = fnv1a(hash, parts[i].name);
+    hash = fnv1a(hash, parts[i].display_color);
   }
   for (const auto& [name, value] : info.metadata) hash = fnv1a(fnv1a(hash, name), value);
 
@@ -718,9 +724,27 @@ void write_3mf(const std::string& path, const std::vector<ThreeMfObject>& parts,
     auto result = std::to_chars(number, number + sizeof number, v);
     model.append(number, result.ptr);
   };
+  // Display colours: one base material per coloured part, in a group after the objects' ids.
+  std::vector<int> material(parts.size(), -1);
+  int materials = 0;
+  for (size_t i = 0; i < parts.size(); ++i)
+    if (!parts[i].display_color.empty()) material[i] = materials++;
+  const size_t material_group = parts.size() + 1;
+  if (materials > 0) {
+    model += cat("\t\t<basematerials id=\"", material_group, "\">\n");
+    for (size_t i = 0; i < parts.size(); ++i) {
+      if (material[i] < 0) continue;
+      std::string rgba = "#";
+      for (size_t k = 1; k < 7; ++k) rgba += char(std::toupper(static_cast<unsigned char>(parts[i].display_color[k])));
+      model += cat("\t\t\t<base name=\"", xml_escape(parts[i].name), "\" displaycolor=\"", rgba, "FF\" />\n");
+    }
+    model += "\t\t</basematerials>\n";
+  }
   for (size_t i = 0; i < parts.size(); ++i) {
-    model += cat("\t\t<object id=\"", i + 1, "\" name=\"", xml_escape(parts[i].name), "\" type=\"model\" p:UUID=\"",
-                 content_uuid(hash, i == 0 ? 1 : 2 + 2 * i), "\">\n\t\t\t<mesh>\n\t\t\t\t<vertices>\n");
+    const std::string property =
+        material[i] < 0 ? std::string() : cat(" pid=\"", material_group, "\" pindex=\"", material[i], "\"");
+    model += cat("\t\t<object id=\"", i + 1, "\" name=\"", xml_escape(parts[i].name), "\" type=\"model\"", property,
+                 " p:UUID=\"", content_uuid(hash, i == 0 ? 1 : 2 + 2 * i), "\">\n\t\t\t<mesh>\n\t\t\t\t<vertices>\n");
     for (const NMR::MODELMESHVERTEX& v : all_vertices[i]) {
       model += "\t\t\t\t\t<vertex x=\"";
       put_float(v.m_fPosition[0]);

@@ -683,8 +683,10 @@ TEST(Cli, FillMotifsColourClassesSplitOnePattern) {
   write_file(dir / "split.json", R"({"lacuna_recipe": 1, "name": "split", "voxel_size_mm": 0.1, "inputs": {
       "all": {)" + fill + R"(},
       "even": {)" + fill + R"(, "color_class": {"by": "orbit", "classes": 2, "keep": 0}},
-      "odd": {)" + fill + R"(, "color_class": {"by": "orbit", "classes": 2, "keep": 1}}},
-    "outputs": [{"of": "all", "file": "all.stl"}, {"of": ["even", "odd"], "file": "two.3mf"}]})");
+      "odd": {)" + fill + R"(, "color_class": {"by": "orbit", "classes": 2, "keep": 1}},
+      "split": {)" + fill + R"(, "color_class": {"by": "orbit", "classes": 2, "palette": ["#102030", "#A0B0C0"]}}},
+    "outputs": [{"of": "all", "file": "all.stl"}, {"of": ["even", "odd"], "file": "two.3mf"},
+                {"of": "split", "file": "split.stl"}, {"of": "split", "file": "split.3mf"}]})");
   Result r = lacuna("run " + quote((dir / "split.json").string()) + " -o " + quote((dir / "out").string()), dir.path());
   ASSERT_EQ(r.code, 0) << r.err;
   const nlohmann::json report = nlohmann::json::parse(read_file(dir / "out" / "report.json"));
@@ -694,6 +696,39 @@ TEST(Cli, FillMotifsColourClassesSplitOnePattern) {
   EXPECT_EQ(in["odd"]["fundamental_region_motifs"], 6);
   EXPECT_EQ(in["all"]["motifs"], 12 * 4 * 4);
   EXPECT_EQ(in["even"]["motifs"].get<int>() + in["odd"]["motifs"].get<int>(), 12 * 4 * 4);
+  // Without "keep" one input splits itself: split-0 and split-1 are the classes (as even and odd), split their
+  // union; a 3MF of it holds the two classes as objects with their display colours, an STL the whole pattern.
+  EXPECT_EQ(in["split-0"]["fundamental_region_motifs"], 6);
+  EXPECT_EQ(in["split-1"]["fundamental_region_motifs"], 6);
+  EXPECT_EQ(in["split-0"]["motifs"], in["even"]["motifs"]);
+  EXPECT_EQ(in["split-1"]["motifs"], in["odd"]["motifs"]);
+  std::map<std::string, nlohmann::json> out;
+  for (const auto& o : report["outputs"]) out[fs::path(o["file"].get<std::string>()).filename().string()] = o;
+  EXPECT_EQ(out["split.3mf"]["objects"], (nlohmann::json{"split-0", "split-1"}));
+  EXPECT_EQ(out["split.3mf"]["triangles"], out["two.3mf"]["triangles"]);
+  EXPECT_EQ(out["split.3mf"]["volume_mm3"], out["two.3mf"]["volume_mm3"]);
+  EXPECT_NEAR(out["split.stl"]["volume_mm3"].get<double>(), out["all.stl"]["volume_mm3"].get<double>(),
+              1e-4 * out["all.stl"]["volume_mm3"].get<double>());
+  EXPECT_EQ(out["split.stl"]["components"], out["all.stl"]["components"]);
+  if (have("prusa-slicer")) {
+    // PrusaSlicer reads the package as two objects (one block each).
+    Result p = run("prusa-slicer --info " + quote((dir / "out" / "split.3mf").string()), dir.path());
+    EXPECT_EQ(p.code, 0) << p.err;
+    size_t blocks = 0;
+    for (size_t at = p.out.find("[split.3mf]"); at != std::string::npos; at = p.out.find("[split.3mf]", at + 1)) ++blocks;
+    EXPECT_EQ(blocks, 2u) << p.out;
+  }
+  // Splitting needs two classes at least, and a colour for each.
+  for (const auto& [classes, why] : {std::pair{R"("classes": 1)", "2 to 64 colour classes"},
+                                     std::pair{R"("classes": 3, "palette": "#000000,#ffffff")", "each of the 3 classes"}}) {
+    write_file(dir / "bad.json", R"({"inputs": {"x": {)" + fill + R"(, "color_class": {)" + classes + R"(}}},
+        "outputs": [{"of": "x", "file": "x.3mf"}]})");
+    Result bad = lacuna("run " + quote((dir / "bad.json").string()) + " -o " + quote((dir / "bad").string()), dir.path());
+    EXPECT_EQ(bad.code, 2) << bad.err;
+    EXPECT_NE(bad.err.find("inputs.x.color_class"), std::string::npos) << bad.err;
+    EXPECT_NE(bad.err.find(why), std::string::npos) << bad.err;
+    EXPECT_FALSE(fs::exists(dir / "bad"));
+  }
 }
 
 TEST(Cli, FillPatternMotifFilesAndColours) {

@@ -329,7 +329,10 @@ RunReport write_outputs(const Recipe& recipe, const Plan& plan, Evaluation&& eva
           const std::string final_path = (out_dir / out.file).string();
           std::string temp = transaction.stage(final_path);
           std::vector<ThreeMfObject> objects3mf;
-          for (const std::string& name : out.group) objects3mf.push_back({&parts[name], name});
+          for (const std::string& name : out.group) {
+            auto color = recipe.display_colors.find(name);
+            objects3mf.push_back({&parts[name], name, color == recipe.display_colors.end() ? "" : color->second});
+          }
           write_3mf(temp, objects3mf, package_info(recipe));
           pending.erase(&out);
           written.push_back({&out, temp, final_path});

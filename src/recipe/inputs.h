@@ -143,11 +143,13 @@ struct FillMotifsInput {
   double wrap_depth_mm = 0;       // > 0: wrapped around the cylinder the pattern's width goes round, this deep
   // "color_class": only the motifs (with all their images) of colour `keep` among `classes`, coloured as
   // `fill pattern --colors` does (fill::motif_colors with the fill's seed): inputs that differ only in
-  // `keep` split one pattern into disjoint objects, e.g. for the parts of a multi-material 3MF.
+  // `keep` split one pattern into disjoint objects, e.g. for the parts of a multi-material 3MF. Without
+  // `keep` the recipe splits the input itself into one object per class (see Recipe::display_colors).
   struct ColorClass {
     fill::Coloring by = fill::Coloring::kSize;
     int classes = 2;
-    int keep = 0;
+    int keep = -1;                     // -1: every class, one object each
+    std::vector<std::string> palette;  // "#rrggbb" per class, the display colours of the split objects
   };
   std::optional<ColorClass> color_class;
 };

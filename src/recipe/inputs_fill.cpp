@@ -117,7 +117,7 @@ FillMotifsInput parse_fill_motifs_input(const JsonObject& o) {
   in.motif = parse_motif(o);
   if (o.has("color_class")) {
     JsonObject c = o.object("color_class");
-    c.allow_only({"by", "classes", "keep"});
+    c.allow_only({"by", "classes", "keep", "palette"});
     FillMotifsInput::ColorClass cc;
     try {
       cc.by = coloring_from_name(c.string_or("by", "size"));
@@ -127,10 +127,38 @@ FillMotifsInput parse_fill_motifs_input(const JsonObject& o) {
     const uint64_t classes = c.unsigned_integer_or("classes", 2);
     if (classes < 1 || classes > 64) c.fail("classes", "expected 1 to 64 colour classes");
     cc.classes = int(classes);
-    if (!c.has("keep")) c.fail("keep", "expected the class to keep, 0 to " + std::to_string(classes - 1));
-    const uint64_t keep = c.unsigned_integer_or("keep", 0);
-    if (keep >= classes) c.fail("keep", "expected a class from 0 to " + std::to_string(classes - 1));
-    cc.keep = int(keep);
+    if (c.has("keep")) {
+      const uint64_t keep = c.unsigned_integer_or("keep", 0);
+      if (keep >= classes) c.fail("keep", "expected a class from 0 to " + std::to_string(classes - 1));
+      cc.keep = int(keep);
+    } else if (classes < 2) {
+      c.fail("classes", "expected 2 to 64 colour classes to split the input into (or \"keep\": 0)");
+    }
+    if (c.has("palette")) {
+      const nlohmann::json& p = c.required("palette");
+      std::string text;
+      if (p.is_string()) {
+        text = p.get<std::string>();
+      } else if (p.is_array()) {
+        for (const auto& e : p) {
+          if (!e.is_string()) c.fail("palette", "expected colours \"#rrggbb\", got " + e.dump());
+          text += (text.empty() ? "" : ",") + e.get<std::string>();
+        }
+      } else {
+        c.fail("palette", "expected a list of colours [\"#rrggbb\", ...] or one string \"#rrggbb,#rrggbb\"");
+      }
+      try {
+        cc.palette = fill::parse_palette(text);
+      } catch (const InvalidInput& e) {
+        c.fail("palette", e.what());
+      }
+      if (cc.palette.size() < classes)
+        c.fail("palette", "expected a colour for each of the " + std::to_string(classes) + " classes, got " +
+                              std::to_string(cc.palette.size()));
+    } else {
+      const std::vector<std::string> dark2 = fill::default_palette();
+      for (uint64_t k = 0; k < classes; ++k) cc.palette.push_back(dark2[k % dark2.size()]);
+    }
     in.color_class = cc;
   }
   FillOptions& f = in.fill;

@@ -197,6 +197,42 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
     recipe.inputs.push_back(std::move(input));
   }
 
+  // Inputs coloured into classes without "keep": one part per class and their union under the input's name.
+  std::map<std::string, std::vector<std::string>> split;
+  {
+    std::vector<RecipeInput> expanded;
+    for (RecipeInput& in : recipe.inputs) {
+      const auto* f = std::get_if<FillMotifsInput>(&in.spec);
+      if (!f || !f->color_class || f->color_class->keep >= 0) {
+        expanded.push_back(std::move(in));
+        continue;
+      }
+      std::vector<std::string>& parts = split[in.name];
+      for (int k = 0; k < f->color_class->classes; ++k) {
+        RecipeInput part = in;
+        part.name = in.name + "-" + std::to_string(k);
+        part.json_path = in.json_path;
+        if (names.count(part.name) || !valid_name(part.name))
+          throw InvalidInput(path + ": " + in.json_path + ".color_class: colour class " + std::to_string(k) +
+                             " becomes the object \"" + part.name + "\", " +
+                             (names.count(part.name) ? "which is already the name of an input"
+                                                     : "a name longer than 64 characters") +
+                             "; rename one of them");
+        std::get<FillMotifsInput>(part.spec).color_class->keep = k;
+        recipe.display_colors[part.name] = f->color_class->palette[size_t(k)];
+        names.insert(part.name);
+        parts.push_back(part.name);
+        expanded.push_back(std::move(part));
+      }
+      RecipeOperation whole;
+      whole.name = in.name;
+      whole.json_path = in.json_path;
+      whole.spec = CsgOperation{CsgOperation::Kind::kUnion, parts};
+      recipe.operations.push_back(std::move(whole));
+    }
+    recipe.inputs = std::move(expanded);
+  }
+
   for (const RecipeInput& in : recipe.inputs)
     for (const std::string& dep : dependencies(in.spec)) {
       bool found = false;
@@ -327,6 +363,11 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
     } else {
       out.object = o.string("of");
       known(out.object);
+      auto parts = split.find(out.object);
+      if (parts != split.end() && lower(fs::path(o.string("file")).extension().string()) == ".3mf") {
+        out.group = parts->second;  // one object per colour class
+        out.object = out.group.front();
+      }
     }
     out.file = o.string("file");
     if (!plain_file_name(out.file))

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <variant>
@@ -132,6 +133,10 @@ struct Recipe {
   std::vector<RecipeOperation> operations;
   std::vector<RecipeOutput> outputs;
   PrintabilitySettings printability;
+  // Objects a recipe split itself into, with their display colours ("#rrggbb") in a 3MF: a fill_motifs
+  // input NAME coloured without "keep" becomes NAME-0 ... NAME-(K-1), one colour class each, and the
+  // union operation NAME of them (first in `operations`); a .3mf of NAME holds the K parts as objects.
+  std::map<std::string, std::string> display_colors;
 };
 
 // The default deviation of compact meshes, in voxels. Measured on the constant-density capsule

@@ -47,6 +47,47 @@ def test_run_gives_the_command_line_report(tmp_path, cli):
     assert meshes["cut.stl"].genus == entry["genus"] == 1
 
 
+def test_a_fill_split_by_colour_class_is_a_coloured_multi_object_3mf(tmp_path):
+    # One fill_motifs input coloured by size class without "keep": the 3MF read here with zipfile and
+    # ElementTree holds one object per class, each pointing at a base material of its palette colour, and
+    # their volumes (computed here from the XML's triangles) add up to the file's.
+    import xml.etree.ElementTree as ET
+    import zipfile
+
+    recipe = {
+        "voxel_size_mm": 0.12,
+        "inputs": {"tiles": {"type": "fill_motifs", "motif": "hexagon", "height_mm": 1, "count": 10, "seed": 2,
+                             "gap_mm": 0.2, "region": {"disk": {"center_mm": [0, 0], "radius_mm": 8}},
+                             "color_class": {"by": "size", "classes": 3, "palette": "#ff0000,#00ff00,#0000ff"}}},
+        "outputs": [{"of": "tiles", "file": "tiles.3mf"}],
+    }
+    result = lacuna.run(recipe, output_dir=tmp_path / "out", write_report=False)
+    entry = result.report["outputs"][0]
+    assert entry["objects"] == ["tiles-0", "tiles-1", "tiles-2"]
+    ns = {"m": "http://schemas.microsoft.com/3dmanufacturing/core/2015/02"}
+    with zipfile.ZipFile(tmp_path / "out" / "tiles.3mf") as z:
+        model = ET.fromstring(z.read("3D/3dmodel.model"))
+    groups = model.findall("m:resources/m:basematerials", ns)
+    assert len(groups) == 1
+    colours = [b.get("displaycolor") for b in groups[0].findall("m:base", ns)]
+    assert colours == ["#FF0000FF", "#00FF00FF", "#0000FFFF"]
+    total = 0.0
+    objects = model.findall("m:resources/m:object", ns)
+    assert [o.get("name") for o in objects] == entry["objects"]
+    for i, o in enumerate(objects):
+        assert o.get("pid") == groups[0].get("id") and o.get("pindex") == str(i)
+        v = np.array([[float(x.get(k)) for k in "xyz"] for x in o.findall("m:mesh/m:vertices/m:vertex", ns)])
+        t = np.array([[int(x.get(k)) for k in ("v1", "v2", "v3")] for x in o.findall("m:mesh/m:triangles/m:triangle", ns)])
+        volume = np.einsum("ij,ij->i", v[t[:, 0]], np.cross(v[t[:, 1]], v[t[:, 2]])).sum() / 6
+        assert volume > 0
+        total += volume
+    assert total == pytest.approx(entry["volume_mm3"], rel=1e-6)
+    # The motifs of a size class are the octaves of area: hexagon i has area proportional to (2 + i)^-1.3.
+    sizes = [result.report["inputs"]["tiles-%d" % k]["motifs"] for k in range(3)]
+    octave = [int(np.floor(1.3 * np.log2((2 + i) / 2) + 1e-12)) % 3 for i in range(10)]
+    assert sizes == [octave.count(k) for k in range(3)]
+
+
 def test_draco_outputs_and_pictures(tmp_path):
     recipe = dict(RECIPE, outputs=[{"of": "cut", "file": "cut.drc", "render": "cut.png"}])
     result = lacuna.run(recipe, output_dir=tmp_path / "out")
