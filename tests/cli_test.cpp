@@ -37,10 +37,12 @@ using test::Result;
 using test::TempDir;
 using test::write_file;
 
+// The recipes of samples/ and of the gallery of the sources' figures (samples/gallery/).
 std::vector<fs::path> sample_recipes() {
   std::vector<fs::path> out;
-  for (const auto& e : fs::directory_iterator(fs::path(LACUNA_SOURCE_DIR) / "samples"))
-    if (e.path().extension() == ".json" && e.path().stem().extension() != ".expected") out.push_back(e.path());
+  for (const char* folder : {"samples", "samples/gallery"})
+    for (const auto& e : fs::directory_iterator(fs::path(LACUNA_SOURCE_DIR) / folder))
+      if (e.path().extension() == ".json" && e.path().stem().extension() != ".expected") out.push_back(e.path());
   std::sort(out.begin(), out.end());
   return out;
 }
@@ -176,12 +178,18 @@ TEST_P(Sample, RunsAndEveryOutputPassesTheChecks) {
 
 std::vector<std::string> sample_names() {
   std::vector<std::string> names;
-  for (const fs::path& p : sample_recipes()) names.push_back(p.stem().string());
+  // The path under samples/ without ".json": "bracket", "gallery/p6m_mosaic".
+  for (const fs::path& p : sample_recipes())
+    names.push_back(fs::relative(p, fs::path(LACUNA_SOURCE_DIR) / "samples").replace_extension().generic_string());
   return names;
 }
 
 INSTANTIATE_TEST_SUITE_P(Samples, Sample, ::testing::ValuesIn(sample_names()),
-                         [](const ::testing::TestParamInfo<std::string>& param_info) { return param_info.param; });
+                         [](const ::testing::TestParamInfo<std::string>& param_info) {
+                           std::string name = param_info.param;
+                           std::replace(name.begin(), name.end(), '/', '_');
+                           return name;
+                         });
 
 // --- determinism -------------------------------------------------------------------------------
 
