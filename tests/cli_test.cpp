@@ -873,6 +873,43 @@ TEST(Cli, VoronoiTilesPartitionThePeriod) {
 // towards x = 12 mm, each tile drawn with one level of detail. Inside a 0.6 mm skin the part is one solid (one
 // outward shell) whose closed cells (cavity shells) crowd where the field is high, many more of them than in
 // the unrefined foam of the same walls' level (3); every level keeps some tiles.
+TEST(Cli, VoronoiTilesRefinedWhereTheFieldIsHigh) {
+  // The 2D example's three fractal cells at level 3 as 1 mm plates 0.3 mm apart, plain and refined by a ramp
+  // along x over two levels. Every wall between tiles loses half the clearance on each side, so the plate's
+  // area is the period's 40^2 less 0.3 times the length of the walls between tiles (the report's, from the
+  // exact Voronoi walls; up to the corners, O(0.3^2) each); refining adds walls between the sub-tiles.
+  TempDir dir;
+  auto tiles = [&](const std::string& name, const std::string& extra) {
+    write_file(dir / (name + ".json"), R"({"voxel_size_mm": 0.05, "inputs": {"t": {"type": "voronoi_tiles", "dimension": 2,
+        "d": 2, "points": [[0.86, 0.3], [0.3, 0.65], [0.73, 0.85]], "level": 3, "period_mm": 40, "clearance_mm": 0.3,
+        "thickness_mm": 1)" + extra + R"(}}, "outputs": [{"of": "t", "file": "t.stl"}]})");
+    Result r = lacuna("run " + quote((dir / (name + ".json")).string()) + " -o " + quote((dir / name).string()) + " --json",
+                      dir.path());
+    EXPECT_EQ(r.code, 0) << r.err;
+    nlohmann::json out = nlohmann::json::parse(r.out)["outputs"][0];
+    out["input"] = nlohmann::json::parse(read_file(dir / name / "report.json"))["inputs"]["t"];
+    return out;
+  };
+  const nlohmann::json plain = tiles("plain", "");
+  const nlohmann::json refined =
+      tiles("refined", R"(, "refine": {"field": "ramp", "axis": [1, 0, 0], "from_mm": 0, "to_mm": 40, "levels": 2})");
+  for (const nlohmann::json* o : {&plain, &refined}) {
+    const double expected = 1600 - 0.3 * (*o)["input"]["wall_length_mm"].get<double>();
+    EXPECT_NEAR((*o)["volume_mm3"].get<double>(), expected, 0.002 * expected);
+    EXPECT_TRUE((*o)["checks"]["valid"].get<bool>());
+  }
+  EXPECT_FALSE(plain["input"].contains("tiles_per_level"));
+  EXPECT_EQ(plain["components"], 3);  // the three fractal cells
+  // The ramp asks for a level-1 split where x > 40/3 and a level-2 one where x > 80/3: every level-1 tile of
+  // the three straddles the first threshold somewhere, so some are split twice.
+  const std::vector<int> per_level = refined["input"]["tiles_per_level"].get<std::vector<int>>();
+  ASSERT_EQ(per_level.size(), 3u);
+  EXPECT_GT(per_level[1], 0);
+  EXPECT_GT(per_level[2], 0);
+  EXPECT_EQ(refined["components"], per_level[0] + per_level[1] + per_level[2]);  // each tile its own piece
+  EXPECT_GT(refined["input"]["wall_length_mm"].get<double>(), plain["input"]["wall_length_mm"].get<double>());
+}
+
 TEST(Cli, VoronoiFoamRefinedWhereTheFieldIsHigh) {
   TempDir dir;
   auto recipe = [](const std::string& refine) {

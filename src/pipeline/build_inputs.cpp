@@ -478,22 +478,53 @@ class Builder {
     out_.report = VoronoiSpheresReport{points_k.points.size(), s.centers_mm.size()};
   }
 
-  // Compact tiles: each kept colour's fractal cell around its starting point, with a clearance to the others.
+  // `refine` (voronoi_tiles, voronoi_foam): the partition's fractal cells, each replaced by its children while
+  // the field at its generator asks for it, every tile drawn with `level` levels of detail; part.level's colours
+  // become the tiles. Returns the tiles' starting colours and counts per level.
+  voronoi::RefinedLevel refine(Partition& part, const VoronoiPartition& partition, const GradeField& field,
+                               int levels, bool keep_unwrapped) {
+    const voronoi::TorusPlacement& place = part.place;
+    try {
+      voronoi::RefinedLevel refined = voronoi::refine_level(
+          part.rules, partition.level, levels,
+          [&](const std::vector<double>& x, int l) {
+            const Vec3d p = place.to_mm(x[0], x[1], place.dimension == 3 ? x[2] : 0.0);
+            return field.at(p) > double(l + 1) / double(levels + 1);
+          },
+          keep_unwrapped);
+      part.level = std::move(refined.level);
+      return refined;
+    } catch (const ResourceLimit& e) {
+      throw ResourceLimit(where() + ".refine: " + e.what());
+    }
+  }
+
+  // Compact tiles: each kept colour's fractal cell around its starting point, with a clearance to the others;
+  // with `refine`, each of its refined tiles.
   void add(const VoronoiTilesInput& v) {
-    const Partition part = partition(v.partition, true);
+    Partition part = partition(v.refine_levels ? with_level(v.partition, 0) : v.partition, !v.refine_levels);
     const std::vector<char> keep = kept(v.colours, part.rules.points.size());
+    // The tiles drawn and the starting colour of each: without refinement the m fractal cells.
+    std::vector<int> tile_colour(keep.size());
+    for (size_t c = 0; c < keep.size(); ++c) tile_colour[c] = int(c);
+    std::vector<int> tiles_per_level;
+    if (v.refine_levels) {
+      voronoi::RefinedLevel refined = refine(part, v.partition, v.refine, v.refine_levels, true);
+      tile_colour = std::move(refined.tile_colour);
+      tiles_per_level = std::move(refined.tiles_per_level);
+    }
+    std::vector<char> keep_tile(tile_colour.size());
+    for (size_t t = 0; t < tile_colour.size(); ++t) keep_tile[t] = keep[size_t(tile_colour[t])];
     size_t pieces = 0;
-    for (int colour = 0; colour < int(keep.size()); ++colour) {
-      if (!keep[size_t(colour)]) continue;
-      for (const voronoi::ConvexPiece& piece :
-           voronoi::tile_pieces(part.rules, part.level, colour, v.clearance_mm / 2 / part.place.period_mm)) {
-        voronoi::add_piece(part.place, piece.faces, v.thickness_mm, out_.geometry);
-        ++pieces;
-      }
+    for (const voronoi::ConvexPiece& piece :
+         voronoi::tile_pieces(part.rules, part.level, keep_tile, v.clearance_mm / 2 / part.place.period_mm)) {
+      voronoi::add_piece(part.place, piece.faces, v.thickness_mm, out_.geometry);
+      ++pieces;
     }
     VoronoiWallsReport report = walls_report(part, voronoi::extract_walls(part.rules, part.level));
     report.pieces = pieces;
     report.clearance_mm = v.clearance_mm;
+    report.tiles_per_level = tiles_per_level;
     out_.report = report;
   }
 
@@ -501,24 +532,7 @@ class Builder {
   void add(const VoronoiFoamInput& v) {
     Partition part = partition(v.refine_levels ? with_level(v.partition, 0) : v.partition, false);
     std::vector<int> tiles_per_level;
-    if (v.refine_levels) {
-      // The partition's fractal cells, each replaced by its children while the field at its generator asks for
-      // it, every tile drawn with `level` levels of detail.
-      const voronoi::TorusPlacement& place = part.place;
-      const GradeField& field = v.refine;
-      const int levels = v.refine_levels;
-      try {
-        voronoi::RefinedLevel refined = voronoi::refine_level(
-            part.rules, v.partition.level, levels, [&](const std::vector<double>& x, int l) {
-              const Vec3d p = place.to_mm(x[0], x[1], place.dimension == 3 ? x[2] : 0.0);
-              return field.at(p) > double(l + 1) / double(levels + 1);
-            });
-        part.level = std::move(refined.level);
-        tiles_per_level = std::move(refined.tiles_per_level);
-      } catch (const ResourceLimit& e) {
-        throw ResourceLimit(where() + ".refine: " + e.what());
-      }
-    }
+    if (v.refine_levels) tiles_per_level = refine(part, v.partition, v.refine, v.refine_levels, false).tiles_per_level;
     const voronoi::Walls walls = voronoi::extract_walls(part.rules, part.level);
     VoronoiWallsReport report = walls_report(part, walls);
     report.tiles_per_level = tiles_per_level;

@@ -196,6 +196,10 @@ struct VoronoiTilesInput {
   std::vector<int> colours;  // 1-based; empty: every colour
   double clearance_mm = 0;
   double thickness_mm = 0;   // 2D: the plate's thickness
+  // `refine` as for the foam: the kept colours' fractal cells split into their refined tiles, each its own
+  // piece with the clearance to its neighbours.
+  GradeField refine;
+  int refine_levels = 0;
 };
 
 // "voronoi_foam": the walls between colours, thickened, over whole periods.

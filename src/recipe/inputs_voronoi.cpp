@@ -60,6 +60,18 @@ std::vector<int> parse_colours(const JsonObject& o, size_t m) {
   return colours;
 }
 
+// "refine": {field keys, "levels"} (voronoi_tiles, voronoi_foam).
+void parse_refine(const JsonObject& o, GradeField& field, int& levels) {
+  if (!o.has("refine")) return;
+  const JsonObject r = o.object("refine");
+  r.allow_only({"field", "axis", "from_mm", "to_mm", "points_mm", "falloff_mm", "depth_mm", "levels"});
+  if (r.string("field") == "depth") r.fail("field", "a partition has no hull to measure depth in: use \"ramp\" or \"points\"");
+  field = parse_grade_field(r, "");
+  const uint64_t n = r.unsigned_integer_or("levels", 1);
+  if (n < 1 || n > 6) r.fail("levels", "expected 1 to 6 refinement levels");
+  levels = int(n);
+}
+
 std::array<int, 3> parse_tiles(const JsonObject& o, int n) {
   std::array<int, 3> tiles{1, 1, 1};
   if (!o.has("tiles")) return tiles;
@@ -93,6 +105,7 @@ VoronoiTilesInput parse_voronoi_tiles_input(const JsonObject& o) {
     o.fail("clearance_mm", "expected a gap from 0 to a quarter of period_mm");
   if (in.partition.dimension == 2) in.thickness_mm = o.positive_length("thickness_mm");
   else if (o.has("thickness_mm")) o.fail("thickness_mm", "only 2D partitions are extruded into plates");
+  parse_refine(o, in.refine, in.refine_levels);
   return in;
 }
 
@@ -106,15 +119,7 @@ VoronoiFoamInput parse_voronoi_foam_input(const JsonObject& o) {
   if (o.has("tiles") && o.has("cover")) o.fail("cover", "give \"tiles\" or \"cover\", not both");
   if (o.has("cover")) in.cover = o.string("cover");
   else in.tiles = parse_tiles(o, in.partition.dimension);
-  if (o.has("refine")) {
-    const JsonObject r = o.object("refine");
-    r.allow_only({"field", "axis", "from_mm", "to_mm", "points_mm", "falloff_mm", "depth_mm", "levels"});
-    if (r.string("field") == "depth") r.fail("field", "a foam has no hull to measure depth in: use \"ramp\" or \"points\"");
-    in.refine = parse_grade_field(r, "");
-    const uint64_t levels = r.unsigned_integer_or("levels", 1);
-    if (levels < 1 || levels > 6) r.fail("levels", "expected 1 to 6 refinement levels");
-    in.refine_levels = int(levels);
-  }
+  parse_refine(o, in.refine, in.refine_levels);
   return in;
 }
 

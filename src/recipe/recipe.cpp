@@ -72,7 +72,7 @@ const std::map<std::string, InputType>& types() {
               parse_as<FillSpheresInput, parse_fill_spheres_input>},
              {"voronoi_spheres", voronoi_keys({"radius_mm", "colours", "tiles"}),
               parse_as<VoronoiSpheresInput, parse_voronoi_spheres_input>},
-             {"voronoi_tiles", voronoi_keys({"colours", "clearance_mm", "thickness_mm"}),
+             {"voronoi_tiles", voronoi_keys({"colours", "clearance_mm", "thickness_mm", "refine"}),
               parse_as<VoronoiTilesInput, parse_voronoi_tiles_input>},
              {"voronoi_foam", voronoi_keys({"wall_mm", "tiles", "cover", "thickness_mm", "refine"}),
               parse_as<VoronoiFoamInput, parse_voronoi_foam_input>},

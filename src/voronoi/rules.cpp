@@ -442,11 +442,11 @@ Level generate_level(const Rules& rules, int k, bool keep_unwrapped) {
 }
 
 RefinedLevel refine_level(const Rules& rules, int detail, int levels,
-                          const std::function<bool(const std::vector<double>& x, int l)>& refine) {
+                          const std::function<bool(const std::vector<double>& x, int l)>& refine, bool keep_unwrapped) {
   if (detail < 0 || levels < 0)
     throw InvalidInput("voronoi: a refined level needs detail >= 0 and levels >= 0, got " + std::to_string(detail) +
                        " and " + std::to_string(levels));
-  return refined(rules, detail, levels, &refine, false);
+  return refined(rules, detail, levels, &refine, keep_unwrapped);
 }
 
 std::vector<double> cell_measures_2d(const Level& level) { return scan_cells(level, 2, false).measures; }

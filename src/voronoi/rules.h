@@ -89,8 +89,9 @@ Level generate_level(const Rules& rules, int k, bool keep_unwrapped = false);
 // with scaled children, and each of its points is coloured by the tile it ends in: `level.colours` are tile
 // indices (colour_count the number of tiles, in the order of the spec's recursion), so walls between colours
 // are the walls between tiles, closed across every change of resolution because all of them are faces of one
-// Voronoi diagram. Never refining gives generate_level(rules, detail + levels) itself. Throws InvalidInput
-// for detail < 0 or levels < 0 and ResourceLimit as generate_level.
+// Voronoi diagram. Never refining gives generate_level(rules, detail + levels) itself. keep_unwrapped: also
+// the positions before wrapping, so each tile is compact around its node (for tile_pieces). Throws
+// InvalidInput for detail < 0 or levels < 0 and ResourceLimit as generate_level.
 struct RefinedLevel {
   Level level;
   std::vector<int> tile_level;       // per tile: the level it was kept at (0 .. levels)
@@ -99,7 +100,8 @@ struct RefinedLevel {
   std::vector<int> tiles_per_level;  // how many tiles were kept at each level 0 .. levels
 };
 RefinedLevel refine_level(const Rules& rules, int detail, int levels,
-                          const std::function<bool(const std::vector<double>& x, int l)>& refine);
+                          const std::function<bool(const std::vector<double>& x, int l)>& refine,
+                          bool keep_unwrapped = false);
 
 // The measure of each colour's union of periodic Voronoi cells at a 2D level, exactly (each cell is the
 // torus square around its generator clipped by the bisectors of every generator copy that can reach it), so

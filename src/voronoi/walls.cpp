@@ -1,5 +1,6 @@
 #include "voronoi/walls.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -169,6 +170,13 @@ TriMesh wall_triangles(const Walls& walls, double period_mm, const Vec3d& origin
 }
 
 std::vector<ConvexPiece> tile_pieces(const Rules& rules, const Level& level, int colour, double half_gap) {
+  std::vector<char> keep(size_t(std::max(level.colour_count, colour + 1)), 0);
+  if (colour >= 0) keep[size_t(colour)] = 1;
+  return tile_pieces(rules, level, keep, half_gap);
+}
+
+std::vector<ConvexPiece> tile_pieces(const Rules& rules, const Level& level, const std::vector<char>& keep,
+                                     double half_gap) {
   if (level.unwrapped.size() != level.points.size())
     throw InvalidInput("voronoi tiles: the level needs its unwrapped positions (generate_level(..., true))");
   if (!(half_gap >= 0)) throw InvalidInput("voronoi tiles: the gap must be >= 0");
@@ -178,7 +186,8 @@ std::vector<ConvexPiece> tile_pieces(const Rules& rules, const Level& level, int
   const double scale = 1.0 / double(lattice.D);
   std::vector<ConvexPiece> pieces;
   for (size_t i = 0; i < level.points.size(); ++i) {
-    if (level.colours[i] != colour) continue;
+    const int colour = level.colours[i];
+    if (colour < 0 || size_t(colour) >= keep.size() || !keep[size_t(colour)]) continue;
     const int shape = level.shapes[i];
     const Cell& cell = cells[size_t(shape)];
     const auto& u = level.unwrapped[i];

@@ -55,6 +55,10 @@ struct ConvexPiece {
 // (torus units), so that neighbouring tiles keep a clearance of 2 half_gap. Cells that the gap swallows are
 // left out. Throws InvalidInput as extract_walls does, or when the level has no unwrapped positions.
 std::vector<ConvexPiece> tile_pieces(const Rules& rules, const Level& level, int colour, double half_gap);
+// The same for every colour c with keep[c] (keep has level.colour_count entries) in one pass over the level,
+// the pieces in the level's point order.
+std::vector<ConvexPiece> tile_pieces(const Rules& rules, const Level& level, const std::vector<char>& keep,
+                                     double half_gap);
 
 }  // namespace voronoi
 }  // namespace lacuna
