@@ -1,12 +1,16 @@
 // The CIFS engine, NURBS automata and shipped systems against known values.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <set>
 
 #include "cifs/automaton.h"
+#include "cifs/junction.h"
 #include "cifs/library.h"
+#include "cifs/support.h"
 #include "cifs/nurbs.h"
 #include "cifs/tessellate.h"
 #include "errors.h"
@@ -320,6 +324,273 @@ TEST(Library, ExplicitAutomatonFromJson) {
   nlohmann::json broken = spec;
   broken["transitions"][0]["matrix"][0][0] = 0.7;
   EXPECT_THROW(parse_system(broken, "test", "system"), InvalidInput);
+}
+
+}  // namespace
+}  // namespace cifs
+}  // namespace lacuna
+
+namespace lacuna {
+namespace cifs {
+namespace {
+
+// A bi-quadratic NURBS patch A (non-uniform knots in u) and a NURBS x Takagi patch B sharing A's u
+// automaton, B 4 mm beyond A's v = 1 border, both wavy in z.
+struct JunctionSides {
+  TensorSurface a, b;
+};
+
+JunctionSides junction_sides() {
+  JunctionSides s;
+  s.a.u = nurbs_automaton(2, {0, 1, 3, 4}).automaton;
+  s.a.v = nurbs_automaton(2, {0, 1, 2, 3}).automaton;
+  s.b.u = s.a.u;
+  s.b.v = library_system("takagi_curve").automaton;
+  s.a.control_points.resize(3, 9);
+  s.b.control_points.resize(3, 9);
+  for (int i = 0; i < 3; ++i)
+    for (int l = 0; l < 3; ++l) {
+      s.a.control_points.col(i * 3 + l) << 6.0 * i, 5.0 * l, (i + l) % 2 ? 1.5 : -0.5;
+      // The Takagi frame (origin, e1, e2): the curve runs from the origin to e1, e2 lifts it.
+      const Eigen::Vector3d origin(6.0 * i, 14, 0.5 * i);
+      const Eigen::Vector3d lift = l == 2 ? Eigen::Vector3d(0, 0, 3) : Eigen::Vector3d(0, 0, 0);
+      s.b.control_points.col(i * 3 + l) = origin + (l == 1 ? Eigen::Vector3d(0, 10, 0) : Eigen::Vector3d(0, 0, 0)) + lift;
+    }
+  return s;
+}
+
+// Per word of u symbols, the two corners of the level's piece whose v symbols are all `v_symbol`
+// (its first v symbol `first`), at the border v = `border` (0: corners 0, 1; 1: corners 3, 2).
+std::map<std::vector<int>, std::pair<Eigen::Vector3d, Eigen::Vector3d>> border_pieces(const Cifs& c, int level, int v_alphabet,
+                                                                                    int first, int v_symbol, int border) {
+  std::map<std::vector<int>, std::pair<Eigen::Vector3d, Eigen::Vector3d>> out;
+  for_each_piece(c, level, [&](const Piece& p) {
+    std::vector<int> u;
+    for (size_t i = 0; i < p.word->size(); ++i) {
+      const int v = (*p.word)[i] % v_alphabet;
+      if (v != (i == 0 ? first : v_symbol)) return;
+      u.push_back((*p.word)[i] / v_alphabet);
+    }
+    const Eigen::Matrix3Xd& x = *p.vertices;
+    out[u] = border == 0 ? std::make_pair(Eigen::Vector3d(x.col(0)), Eigen::Vector3d(x.col(1)))
+                         : std::make_pair(Eigen::Vector3d(x.col(3)), Eigen::Vector3d(x.col(2)));
+  });
+  return out;
+}
+
+Cifs side_system(const TensorSurface& s) { return Cifs{"side", tensor_product(s.u, s.v), s.control_points, false}; }
+
+TEST(Junction, BorderPiecesCoincideWithTheSidesAtEveryLevel) {
+  const JunctionSides s = junction_sides();
+  Cifs j = junction(s.a, s.b, JunctionOptions{});
+  complete_primitives(j.automaton);
+  Cifs a = side_system(s.a), b = side_system(s.b);
+  complete_primitives(a.automaton);
+  complete_primitives(b.automaton);
+  // Six transformations: two along u, three across (to A's nature, to the junction, to B's).
+  ASSERT_EQ(j.automaton.transitions[size_t(j.automaton.initial)].size(), 6u);
+  const int wj = j.automaton.alphabet_size / 2, wa = a.automaton.alphabet_size / 2, wb = b.automaton.alphabet_size / 2;
+  ASSERT_EQ(wj, 3);
+  for (int level = 1; level <= 6; ++level) {
+    // J at v = 0 (first to A's nature, then A's first symbol) against A at v = 1 (A's last symbol).
+    const auto j0 = border_pieces(j, level, wj, 0, 0, 0), a1 = border_pieces(a, level, wa, wa - 1, wa - 1, 1);
+    const auto j1 = border_pieces(j, level, wj, 2, wb - 1, 1), b0 = border_pieces(b, level, wb, 0, 0, 0);
+    ASSERT_EQ(j0.size(), size_t(1) << level);
+    ASSERT_EQ(a1.size(), j0.size());
+    ASSERT_EQ(j1.size(), j0.size());
+    ASSERT_EQ(b0.size(), j0.size());
+    double worst = 0;
+    for (const auto& [word, corners] : j0) {
+      worst = std::max({worst, (corners.first - a1.at(word).first).norm(), (corners.second - a1.at(word).second).norm()});
+      worst = std::max({worst, (j1.at(word).first - b0.at(word).first).norm(), (j1.at(word).second - b0.at(word).second).norm()});
+    }
+    EXPECT_LT(worst, 1e-12) << "level " << level;
+  }
+}
+
+// The welded mesh of a surface: vertices, edges, faces and boundary edges.
+struct MeshCounts {
+  long vertices = 0, edges = 0, faces = 0, boundary = 0;
+};
+
+MeshCounts counts(const TriMesh& m) {
+  std::map<std::pair<uint32_t, uint32_t>, int> edges;
+  for (const auto& t : m.triangles)
+    for (int e = 0; e < 3; ++e) ++edges[{std::min(t[e], t[(e + 1) % 3]), std::max(t[e], t[(e + 1) % 3])}];
+  MeshCounts c;
+  c.vertices = long(m.positions_mm.size());
+  c.faces = long(m.triangles.size());
+  c.edges = long(edges.size());
+  for (const auto& [edge, n] : edges) c.boundary += n == 1;
+  return c;
+}
+
+TEST(Junction, JunctionAndSidesAreOneDiscAndTheMiddleShrinksToTheMidpoint) {
+  const JunctionSides s = junction_sides();
+  JunctionOptions options;
+  options.sides = true;
+  Cifs all = junction(s.a, s.b, options);
+  Cifs a = side_system(s.a), b = side_system(s.b), j = junction(s.a, s.b, JunctionOptions{});
+  for (int level = 1; level <= 5; ++level) {
+    // Level L of the assembly is A, J and B each at level L.
+    EXPECT_EQ(count_pieces(all.automaton, level),
+              count_pieces(a.automaton, level) + count_pieces(j.automaton, level) + count_pieces(b.automaton, level));
+    // Welded, the three are one disc: no seam between them (a seam would leave boundary edges inside
+    // and raise the Euler characteristic above 1) and no overlap.
+    const MeshCounts c = counts(tessellate_surface(all, level));
+    EXPECT_EQ(c.vertices - c.edges + c.faces, 1) << "level " << level;
+    const MeshCounts cj = counts(tessellate_surface(j, level));
+    EXPECT_EQ(cj.vertices - cj.edges + cj.faces, 1) << "level " << level;
+    // The outline of the disc: the four borders of the three surfaces, each of 2^L edges along u and
+    // the pieces across v on the two sides.
+    EXPECT_EQ(c.boundary, 2 * (1L << level) + 2 * long(count_pieces(all.automaton, level) >> level)) << "level " << level;
+  }
+  // The junction's middle (u, v) = (any, J^w) is the midpoint of A's end and B's start, row by row:
+  // at u = 0 it is the midpoint of the two surfaces' corner points there.
+  const Eigen::VectorXd m = limit_point(j.automaton, j.automaton.initial, 1);  // u symbol 0, v symbol 1 (J)
+  const Eigen::Vector3d middle = j.control_points * m;
+  Cifs ca = a, cb = b;
+  complete_primitives(ca.automaton);
+  complete_primitives(cb.automaton);
+  const Eigen::Vector3d a_corner = ca.control_points * ca.automaton.states[size_t(ca.automaton.initial)].vertices.col(3);
+  const Eigen::Vector3d b_corner = cb.control_points * cb.automaton.states[size_t(cb.automaton.initial)].vertices.col(0);
+  EXPECT_LT((middle - 0.5 * (a_corner + b_corner)).norm(), 1e-9);
+}
+
+TEST(Junction, RefusesSidesOfAnotherUAndBadOptions) {
+  JunctionSides s = junction_sides();
+  TensorSurface other = s.b;
+  other.u = nurbs_automaton(2, {0, 1, 2, 3}).automaton;  // uniform: not A's u automaton
+  EXPECT_THROW(junction(s.a, other, JunctionOptions{}), InvalidInput);
+  JunctionOptions wide;
+  wide.ratio = 0.5;
+  EXPECT_THROW(junction(s.a, s.b, wide), InvalidInput);
+  TensorSurface touching = s.b;  // B starting on A's end (the uniform quadratic piece ends mid-way on its last leg)
+  for (int i = 0; i < 3; ++i) {
+    const Eigen::Vector3d shift =
+        0.5 * (s.a.control_points.col(i * 3 + 1) + s.a.control_points.col(i * 3 + 2)) - s.b.control_points.col(i * 3);
+    for (int l = 0; l < 3; ++l) touching.control_points.col(i * 3 + l) += shift;
+  }
+  EXPECT_THROW(junction(s.a, touching, JunctionOptions{}), InvalidInput);
+}
+
+TEST(Junction, ReadFromJsonWithTheSidesAsSystems) {
+  const nlohmann::json side_a = {{"nurbs_surface", {{"u", {{"degree", 2}, {"knots", {0, 1, 3, 4}}}}, {"v", {{"degree", 2}, {"knots", {0, 1, 2, 3}}}}}},
+                                 {"control_points_mm", {{{0, 0, 0}, {0, 5, 1}, {0, 10, 0}}, {{6, 0, 1}, {6, 5, 0}, {6, 10, 1}}, {{12, 0, 0}, {12, 5, 1}, {12, 10, 0}}}}};
+  const nlohmann::json side_b = {{"product", {{{"nurbs_curve", {{"degree", 2}, {"knots", {0, 1, 3, 4}}}}, {"control_points_mm", {{0, 0, 0}, {6, 0, 0}, {12, 0, 0}}}}, "takagi_curve"}},
+                                 {"translate_mm", {0, 14, 0}}};
+  nlohmann::json system = {{"junction", {{"a", side_a}, {"b", side_b}, {"sides", true}}}};
+  Cifs c = parse_system(system, "r.json", "system");
+  EXPECT_EQ(c.control_points.cols(), 3 * 6);
+  // The assembly's first symbols: A's 2 x 2, J's 2 x 3, B's 2 x 2.
+  EXPECT_EQ(c.automaton.transitions[size_t(c.automaton.initial)].size(), 14u);
+  system["junction"]["ratio"] = 0.7;
+  try {
+    parse_system(system, "r.json", "system");
+    FAIL() << "a ratio of 0.7 was accepted";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("ratio"), std::string::npos) << e.what();
+  }
+  system["junction"]["ratio"] = 0.25;
+  system["junction"]["b"]["product"][0]["nurbs_curve"]["knots"] = {0, 1, 2, 3};
+  try {
+    parse_system(system, "r.json", "system");
+    FAIL() << "sides of different u automata were accepted";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("u automaton"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace cifs
+}  // namespace lacuna
+
+namespace lacuna {
+namespace cifs {
+namespace {
+
+// A bi-quadratic dome over [0, 20] x [0, 16] between z = 10 and 14, non-uniform along u.
+Cifs dome() {
+  Cifs c{"dome", tensor_product(nurbs_automaton(2, {0, 1, 3, 4}).automaton, nurbs_automaton(2, {0, 1, 2, 3}).automaton),
+         Eigen::MatrixXd(3, 9), false};
+  for (int i = 0; i < 3; ++i)
+    for (int l = 0; l < 3; ++l) c.control_points.col(i * 3 + l) << 10.0 * i, 8.0 * l, (i == 1 && l == 1) ? 16 : 10 + i;
+  complete_primitives(c.automaton);
+  return c;
+}
+
+TEST(Support, BranchTopsAreTheSurfacePiecesAtEveryLevel) {
+  const Cifs surface = dome();
+  SupportOptions options;
+  options.base_center_mm = Vec3d{10, 8, 0};
+  const Cifs tree = support_tree(surface, options);
+  const int trunk_symbol = surface.automaton.alphabet_size;
+  for (int level = 0; level <= 5; ++level) {
+    // Level L: a trunk for every piece of the levels before, a branch for every piece of this one.
+    uint64_t trunks = 0;
+    for (int l = 0; l < level; ++l) trunks += count_pieces(surface.automaton, l);
+    ASSERT_EQ(count_pieces(tree.automaton, level), trunks + count_pieces(surface.automaton, level));
+    std::map<std::vector<int>, Eigen::Matrix3Xd> pieces;
+    for_each_piece(surface, level, [&](const Piece& p) { pieces[*p.word] = *p.vertices; });
+    size_t branches = 0;
+    double worst = 0;
+    for_each_piece(tree, level, [&](const Piece& p) {
+      if (std::find(p.word->begin(), p.word->end(), trunk_symbol) != p.word->end()) return;
+      ++branches;
+      const Eigen::Matrix3Xd& top = pieces.at(*p.word);
+      for (int c = 0; c < 4; ++c) worst = std::max(worst, (p.vertices->col(4 + c) - top.col(c)).norm());
+    });
+    EXPECT_EQ(branches, pieces.size());
+    EXPECT_LT(worst, 1e-12) << "level " << level;
+  }
+  // The root stands on the plate: level 0's base corners at z = 0 about the given centre.
+  for_each_piece(tree, 0, [&](const Piece& p) {
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (int c = 0; c < 4; ++c) {
+      EXPECT_NEAR(p.vertices->col(c).z(), 0.0, 1e-12);
+      centre += p.vertices->col(c) / 4;
+    }
+    EXPECT_LT((centre - Eigen::Vector3d(10, 8, 0)).norm(), 1e-12);
+  });
+}
+
+TEST(Support, ChildrenStartOnTheirParentsFork) {
+  // Every level-1 branch's base is its parent's trunk top: the fork quad, halfway up and half the base.
+  const Cifs surface = dome();
+  SupportOptions options;
+  options.base_center_mm = Vec3d{10, 8, 0};
+  options.base_size_mm = 4;
+  const Cifs tree = support_tree(surface, options);
+  Eigen::Matrix3Xd trunk, root;
+  for_each_piece(tree, 0, [&](const Piece& p) { root = *p.vertices; });
+  std::vector<Eigen::Matrix3Xd> children;
+  for_each_piece(tree, 1, [&](const Piece& p) {
+    if (p.state == int(tree.automaton.states.size()) - 1) trunk = *p.vertices;
+    else children.push_back(*p.vertices);
+  });
+  ASSERT_EQ(children.size(), 4u);
+  const Eigen::Vector3d base_centre = root.leftCols(4).rowwise().mean(), top_centre = root.rightCols(4).rowwise().mean();
+  const Eigen::Vector3d fork = 0.5 * (base_centre + top_centre);
+  for (int c = 0; c < 4; ++c) {
+    EXPECT_LT((trunk.col(c) - root.col(c)).norm(), 1e-12);
+    const Eigen::Vector3d corner = fork + 0.5 * (root.col(c) - base_centre);
+    EXPECT_LT((trunk.col(4 + c) - corner).norm(), 1e-12);
+    for (const auto& child : children) EXPECT_LT((child.col(c) - corner).norm(), 1e-12);
+  }
+  // The root base is 4 mm across its widest diagonal.
+  double widest = 0;
+  for (int c = 0; c < 4; ++c) widest = std::max(widest, (root.col(c) - base_centre).norm());
+  EXPECT_NEAR(2 * widest, 4.0, 1e-12);
+}
+
+TEST(Support, RefusesABaseAboveTheSurfaceAndCurves) {
+  SupportOptions options;
+  options.base_center_mm = Vec3d{10, 8, 11.5};  // the dome's lowest point is its corner at z = 11.17
+  EXPECT_THROW(support_tree(dome(), options), InvalidInput);
+  options.base_center_mm.z = 0;
+  EXPECT_THROW(support_tree(library_system("takagi_curve"), options), InvalidInput);
+  options.fork = 1;
+  EXPECT_THROW(support_tree(dome(), options), InvalidInput);
 }
 
 }  // namespace

@@ -873,6 +873,36 @@ TEST(Cli, VoronoiTilesPartitionThePeriod) {
 // towards x = 12 mm, each tile drawn with one level of detail. Inside a 0.6 mm skin the part is one solid (one
 // outward shell) whose closed cells (cavity shells) crowd where the field is high, many more of them than in
 // the unrefined foam of the same walls' level (3); every level keeps some tiles.
+TEST(Cli, CifsShellStandsOnItsOwnSupportTree) {
+  // A bi-quadratic roof between z = 11.17 and 14, alone and on its level-3 tree rooted at z = 0: both one
+  // solid, the supported one reaching down to the plate; a base above the roof is refused and writes nothing.
+  TempDir dir;
+  auto roof = [&](const std::string& name, const std::string& support) {
+    write_file(dir / (name + ".json"), R"({"voxel_size_mm": 0.15, "inputs": {"roof": {"type": "cifs", "level": 3,
+        "thickness_mm": 0.8, "system": {"nurbs_surface": {"u": {"degree": 2, "knots": [0, 1, 3, 4]},
+        "v": {"degree": 2, "knots": [0, 1, 2, 3]}}, "control_points_mm": [[[0, 0, 10], [0, 8, 10], [0, 16, 10]],
+        [[10, 0, 11], [10, 8, 16], [10, 16, 11]], [[20, 0, 12], [20, 8, 12], [20, 16, 12]]]})" + support + R"(}},
+        "outputs": [{"of": "roof", "file": "roof.stl"}]})");
+    return lacuna("run " + quote((dir / (name + ".json")).string()) + " -o " + quote((dir / name).string()) + " --json",
+                  dir.path());
+  };
+  Result alone = roof("alone", ""), supported = roof("supported", R"(, "support": {"base_mm": [10, 8, 0], "base_size_mm": 3})");
+  ASSERT_EQ(alone.code, 0) << alone.err;
+  ASSERT_EQ(supported.code, 0) << supported.err;
+  const nlohmann::json a = nlohmann::json::parse(alone.out)["outputs"][0], s = nlohmann::json::parse(supported.out)["outputs"][0];
+  EXPECT_EQ(a["components"], 1);
+  EXPECT_EQ(s["components"], 1);  // the tree and the roof are one part
+  EXPECT_TRUE(s["checks"]["valid"].get<bool>());
+  EXPECT_GT(a["bounding_box_mm"]["min"][2].get<double>(), 10.5);
+  EXPECT_NEAR(s["bounding_box_mm"]["min"][2].get<double>(), 0.0, 0.15);  // the root's base on the plate
+  EXPECT_GT(s["volume_mm3"].get<double>(), a["volume_mm3"].get<double>() + 3 * 3 * 11.0 / 4);  // more than a thin trunk
+  Result above = roof("above", R"(, "support": {"base_mm": [10, 8, 12]})");
+  EXPECT_EQ(above.code, 2);
+  EXPECT_NE(above.err.find("support"), std::string::npos) << above.err;
+  EXPECT_NE(above.err.find("below the surface"), std::string::npos) << above.err;
+  EXPECT_FALSE(fs::exists(dir / "above" / "roof.stl"));
+}
+
 TEST(Cli, VoronoiTilesRefinedWhereTheFieldIsHigh) {
   // The 2D example's three fractal cells at level 3 as 1 mm plates 0.3 mm apart, plain and refined by a ramp
   // along x over two levels. Every wall between tiles loses half the clearance on each side, so the plate's

@@ -245,7 +245,26 @@ class Builder {
       }
     };
     // Scaled (uniformly) and moved so the attractor's box fits the other input's, centred.
-    out_.geometry = c.fit_to ? attractor(cifs::fit_to_box(c.system, box_of(*c.fit_to))) : attractor(c.system);
+    const cifs::Cifs placed = c.fit_to ? cifs::fit_to_box(c.system, box_of(*c.fit_to)) : c.system;
+    out_.geometry = attractor(placed);
+    if (!c.support) return;
+    // The shell's own tree: the branches' tops are the shell's pieces of the same level.
+    cifs::Cifs tree;
+    try {
+      tree = cifs::support_tree(placed, *c.support);
+    } catch (const InvalidInput& e) {
+      throw InvalidInput(where() + ": support: " + e.what());
+    }
+    cifs::SolidOptions cells;
+    cells.as = cifs::SolidOptions::As::kCells;
+    cells.voxel_size_mm = vopt_.voxel_size_mm;
+    GeometrySet branches;
+    try {
+      branches = cifs::attractor_geometry(tree, c.level, cells);
+    } catch (const InvalidInput& e) {
+      throw InvalidInput(where() + ": support: " + e.what());
+    }
+    for (GeometryStream& s : branches.streams) out_.geometry.streams.push_back(std::move(s));
   }
 
   void add(const CurveInput& c) {

@@ -7,6 +7,7 @@
 #include <map>
 #include <sstream>
 
+#include "cifs/junction.h"
 #include "cifs/library.h"
 #include "cifs/nurbs.h"
 #include "errors.h"
@@ -175,6 +176,33 @@ NurbsAutomaton parse_nurbs(const JsonObject& o) {
 // Systems nested in systems ("product", "restrict", "library") at most this deep.
 constexpr int kMaxSystemDepth = 16;
 
+Cifs parse_system_at(const nlohmann::json& value, const std::string& file, const std::string& path, int depth);
+
+// A side of a junction: a tensor surface ("product" of two curves or "nurbs_surface") with its factors
+// kept apart, and its control net.
+TensorSurface parse_tensor_surface(const JsonObject& parent, const char* key, int depth) {
+  const nlohmann::json& value = parent.required(key);
+  if (!value.is_object() || !(value.contains("product") || value.contains("nurbs_surface")))
+    parent.fail(key, "expected a tensor surface: an object with \"product\" (two curves) or \"nurbs_surface\"");
+  JsonObject o(value, parent.file(), parent.path_of(key));
+  TensorSurface out;
+  if (o.has("product")) {
+    const nlohmann::json& pair = o.required("product");
+    if (!pair.is_array() || pair.size() != 2) o.fail("product", "expected a list of two systems");
+    out.u = parse_system_at(pair[0], o.file(), o.path_of("product[0]"), depth + 1).automaton;
+    out.v = parse_system_at(pair[1], o.file(), o.path_of("product[1]"), depth + 1).automaton;
+  } else {
+    JsonObject s = o.object("nurbs_surface");
+    s.allow_only({"u", "v"});
+    out.u = parse_nurbs(s.object("u")).automaton;
+    out.v = parse_nurbs(s.object("v")).automaton;
+  }
+  const Cifs whole = parse_system_at(value, parent.file(), parent.path_of(key), depth + 1);
+  if (whole.rational) parent.fail(key, "a junction's sides must be non-rational (weights 1)");
+  out.control_points = whole.control_points;
+  return out;
+}
+
 Cifs parse_system_at(const nlohmann::json& value, const std::string& file, const std::string& path, int depth) {
   if (depth > kMaxSystemDepth)
     throw InvalidInput(file + ": systems nest deeper than " + std::to_string(kMaxSystemDepth) + " levels (product, restrict)");
@@ -187,11 +215,11 @@ Cifs parse_system_at(const nlohmann::json& value, const std::string& file, const
   }
   JsonObject o(value, file, path);
   o.allow_only({"name", "library", "states", "transitions", "initial", "alphabet_size", "nurbs_curve", "nurbs_surface",
-                "product", "restrict", "drop_symbols", "pattern", "control_points_mm", "scale", "translate_mm"});
+                "product", "restrict", "drop_symbols", "pattern", "junction", "control_points_mm", "scale", "translate_mm"});
   const int kinds = o.has("library") + o.has("states") + o.has("nurbs_curve") + o.has("nurbs_surface") +
-                    o.has("product") + o.has("restrict");
+                    o.has("product") + o.has("restrict") + o.has("junction");
   if (kinds != 1)
-    o.fail("", "give exactly one of \"library\", \"states\", \"nurbs_curve\", \"nurbs_surface\", \"product\", \"restrict\"");
+    o.fail("", "give exactly one of \"library\", \"states\", \"nurbs_curve\", \"nurbs_surface\", \"product\", \"restrict\", \"junction\"");
   Cifs c;
   bool needs_points = false;
   if (o.has("library")) {
@@ -207,6 +235,21 @@ Cifs parse_system_at(const nlohmann::json& value, const std::string& file, const
     s.allow_only({"u", "v"});
     c.automaton = tensor_product(parse_nurbs(s.object("u")).automaton, parse_nurbs(s.object("v")).automaton);
     needs_points = true;
+  } else if (o.has("junction")) {
+    JsonObject j = o.object("junction");
+    j.allow_only({"a", "b", "ratio", "amplitude", "sides"});
+    const TensorSurface a = parse_tensor_surface(j, "a", depth), b = parse_tensor_surface(j, "b", depth);
+    JunctionOptions options;
+    options.ratio = j.number_or("ratio", options.ratio);
+    if (!(options.ratio > 0 && options.ratio < 0.5)) j.fail("ratio", "expected a number strictly between 0 and 0.5");
+    options.amplitude = j.number_or("amplitude", options.amplitude);
+    if (!(options.amplitude >= 0) || !std::isfinite(options.amplitude)) j.fail("amplitude", "expected a finite number >= 0");
+    options.sides = j.boolean_or("sides", false);
+    try {
+      c = junction(a, b, options);
+    } catch (const InvalidInput& e) {
+      o.fail("junction", e.what());
+    }
   } else if (o.has("product")) {
     const nlohmann::json& pair = o.required("product");
     if (!pair.is_array() || pair.size() != 2) o.fail("product", "expected a list of two systems");

@@ -17,6 +17,9 @@ namespace cifs {
 //   "nurbs_surface": {"u": {"degree", "knots"}, "v": {"degree", "knots"}}
 //   "product": [SYSTEM, SYSTEM]            (tensor product; default control points a(u) + b(v))
 //   "restrict": SYSTEM with "drop_symbols": [..] or "pattern": {"states", "transitions"}
+//   "junction": {"a": SURFACE, "b": SURFACE, "ratio", "amplitude", "sides"}   (cifs/junction.h; the
+//               sides are "product" or "nurbs_surface" systems with one u automaton; the junction's
+//               control points are theirs)
 // and optionally "control_points_mm" (replaces the default; [x, y, z] or [x, y, z, w] each, a list of
 // rows for products), "scale" and "translate_mm" (applied to the control points). `path` names the
 // object in messages. Throws InvalidInput naming the file and JSON path.

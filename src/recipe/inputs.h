@@ -15,6 +15,7 @@
 #include "bcifs/volume.h"
 #include "cifs/automaton.h"
 #include "cifs/solid_input.h"
+#include "cifs/support.h"
 #include "curves/curves.h"
 #include "curves/sweep.h"
 #include "fill/fill.h"
@@ -118,6 +119,7 @@ struct CifsInput {
   int level = 3;
   cifs::SolidOptions solid;
   std::optional<std::string> fit_to;  // scaled uniformly and centred in that input's box
+  std::optional<cifs::SupportOptions> support;  // a shell stood on its own fractal tree (cifs/support.h)
 };
 
 // "curve": space-filling curves on a surface as tubes, with an optional base shell.

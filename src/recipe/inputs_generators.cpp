@@ -158,6 +158,24 @@ CifsInput parse_cifs_input(const JsonObject& o) {
   if (o.has("radius_mm")) options.radius_mm = o.positive_length("radius_mm");
   if (o.has("thickness_mm")) options.thickness_mm = o.positive_length("thickness_mm");
   if (o.has("fit_to")) in.fit_to = o.string("fit_to");
+  if (o.has("support")) {
+    JsonObject so = o.object("support");
+    so.allow_only({"base_mm", "base_size_mm", "fork", "shrink"});
+    if (options.as != cifs::SolidOptions::As::kDefault && options.as != cifs::SolidOptions::As::kShell)
+      o.fail("support", "a support stands under a shell: leave \"as\" out or give \"shell\"");
+    for (const cifs::State& s : in.system.automaton.states)
+      if (s.primitive != cifs::Primitive::kQuad)
+        o.fail("support", "a support stands under a tensor surface (quad pieces); state \"" + s.name + "\" is a " +
+                              cifs::primitive_name(s.primitive));
+    cifs::SupportOptions support;
+    support.base_center_mm = so.vec3("base_mm");
+    if (so.has("base_size_mm")) support.base_size_mm = so.positive_length("base_size_mm");
+    support.fork = so.number_or("fork", support.fork);
+    if (!(support.fork > 0 && support.fork < 1)) so.fail("fork", "expected a number strictly between 0 and 1");
+    support.shrink = so.number_or("shrink", support.shrink);
+    if (!(support.shrink > 0 && support.shrink <= 1)) so.fail("shrink", "expected a number in (0, 1]");
+    in.support = support;
+  }
   return in;
 }
 
