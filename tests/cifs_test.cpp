@@ -457,21 +457,155 @@ TEST(Junction, JunctionAndSidesAreOneDiscAndTheMiddleShrinksToTheMidpoint) {
   EXPECT_LT((middle - 0.5 * (a_corner + b_corner)).norm(), 1e-9);
 }
 
-TEST(Junction, RefusesSidesOfAnotherUAndBadOptions) {
-  JunctionSides s = junction_sides();
-  TensorSurface other = s.b;
-  other.u = nurbs_automaton(2, {0, 1, 2, 3}).automaton;  // uniform: not A's u automaton
-  EXPECT_THROW(junction(s.a, other, JunctionOptions{}), InvalidInput);
+// A bi-quadratic NURBS patch A and a Takagi x Takagi patch B whose v = 0 border has A's v = 1 border
+// polygon as its control polygon: the two borders share one polygon and differ in nature along u (A's
+// runs near the polygon's middle, B's from its first point to its second, lifted by its third).
+JunctionSides shared_polygon_sides() {
+  JunctionSides s;
+  s.a = junction_sides().a;
+  s.a.control_points(2, 1 * 3 + 2) += 4;  // A's border polygon bends (a straight one would flatten B's Takagi frame)
+  s.b.u = library_system("takagi_curve").automaton;
+  s.b.v = s.b.u;
+  s.b.control_points.resize(3, 9);
+  for (int i = 0; i < 3; ++i) {
+    const Eigen::Vector3d border = 0.5 * (s.a.control_points.col(i * 3 + 1) + s.a.control_points.col(i * 3 + 2));
+    s.b.control_points.col(i * 3) = border;
+    s.b.control_points.col(i * 3 + 1) = border + Eigen::Vector3d(0, 10, 0);
+    s.b.control_points.col(i * 3 + 2) = border + Eigen::Vector3d(0, 0, 3);
+  }
+  return s;
+}
+
+// The point of `c` reached by the finite word, then the corner `corner` of the piece it addresses.
+Eigen::Vector3d word_corner(const Cifs& c, const std::vector<int>& word, int corner) {
+  int state = c.automaton.initial;
+  Eigen::MatrixXd m = Eigen::MatrixXd::Identity(c.control_points.cols(), c.control_points.cols());
+  for (int symbol : word) {
+    const Transition* t = find_transition(c.automaton, state, symbol);
+    EXPECT_NE(t, nullptr);
+    if (!t) return Eigen::Vector3d::Zero();
+    m = Eigen::MatrixXd(m * t->matrix);
+    state = t->target;
+  }
+  return c.control_points * m * c.automaton.states[size_t(state)].vertices.col(corner);
+}
+
+TEST(Junction, BordersOfTwoNaturesAlongUMeetOnAStraightSeam) {
+  const JunctionSides s = shared_polygon_sides();
+  Cifs j = junction(s.a, s.b, JunctionOptions{});
+  Cifs a = side_system(s.a), b = side_system(s.b);
+  complete_primitives(a.automaton);
+  complete_primitives(b.automaton);
+  // A's u automaton is a non-uniform quadratic NURBS, B's a Takagi curve: J adds F_A and F_B per point of u.
+  EXPECT_EQ(j.control_points.cols(), 3 * (3 + 2 + 3));
+  ASSERT_EQ(j.automaton.transitions[size_t(j.automaton.initial)].size(), 6u);
+  const int wj = j.automaton.alphabet_size / 2, wa = a.automaton.alphabet_size / 2, wb = b.automaton.alphabet_size / 2;
+  ASSERT_EQ(wj, 3);
+  for (int level = 1; level <= 6; ++level) {
+    const auto j0 = border_pieces(j, level, wj, 0, 0, 0), a1 = border_pieces(a, level, wa, wa - 1, wa - 1, 1);
+    const auto j1 = border_pieces(j, level, wj, 2, wb - 1, 1), b0 = border_pieces(b, level, wb, 0, 0, 0);
+    ASSERT_EQ(j0.size(), size_t(1) << level);
+    ASSERT_EQ(a1.size(), j0.size());
+    ASSERT_EQ(j1.size(), j0.size());
+    ASSERT_EQ(b0.size(), j0.size());
+    double worst = 0, apart = 0;
+    for (const auto& [word, corners] : j0) {
+      worst = std::max({worst, (corners.first - a1.at(word).first).norm(), (corners.second - a1.at(word).second).norm()});
+      worst = std::max({worst, (j1.at(word).first - b0.at(word).first).norm(), (j1.at(word).second - b0.at(word).second).norm()});
+      apart = std::max(apart, (corners.first - j1.at(word).first).norm());
+    }
+    EXPECT_LT(worst, 1e-12) << "level " << level;
+    EXPECT_GT(apart, 1.0) << "the two borders are different curves; level " << level;
+  }
+  // The middle (v symbol J forever) is the straight segment from X, the middle of the borders' start
+  // points, to Y, of their end points, with u as its parameter on both natures' sides: at u = 0, 1/4,
+  // 1/2 and 1 (u symbols 0^w, 010^w, 10^w, 1^w), the corners of the deep middle pieces.
+  const Eigen::MatrixXd &av = a.automaton.states[size_t(a.automaton.initial)].vertices,
+                        &bv = b.automaton.states[size_t(b.automaton.initial)].vertices;
+  const Eigen::Vector3d x = 0.5 * (a.control_points * av.col(3) + b.control_points * bv.col(0));
+  const Eigen::Vector3d y = 0.5 * (a.control_points * av.col(2) + b.control_points * bv.col(1));
+  const std::vector<std::pair<std::vector<int>, double>> words = {{{}, 0.0}, {{0, 1}, 0.25}, {{1}, 0.5}, {{1, 1, 1}, 1.0}};
+  for (const auto& [prefix, u] : words) {
+    std::vector<int> word;
+    for (size_t i = 0; i < 40; ++i) word.push_back(3 * (i < prefix.size() ? prefix[i] : (u == 1.0 ? 1 : 0)) + 1);
+    for (int corner : {0, 3}) {
+      const Eigen::Vector3d p = word_corner(j, word, corner);
+      EXPECT_LT((p - (x + u * (y - x))).norm(), 1e-9) << "u " << u << " corner " << corner;
+    }
+  }
+}
+
+TEST(Junction, TwoNaturesAlongUWeldIntoOneDisc) {
+  // B moved 4 mm on and 2 mm up: with one shared polygon (three points, so one plane) the two borders
+  // cross in its plane and J folds flat onto itself, where welding would join unrelated vertices.
+  JunctionSides s = shared_polygon_sides();
+  s.b.control_points.colwise() += Eigen::Vector3d(0, 4, 2);
+  JunctionOptions options;
+  options.sides = true;
+  options.ratio = 0.25;
+  Cifs all = junction(s.a, s.b, options);
+  Cifs a = side_system(s.a), b = side_system(s.b);
+  options.sides = false;
+  Cifs j = junction(s.a, s.b, options);
+  for (int level = 1; level <= 5; ++level) {
+    EXPECT_EQ(count_pieces(all.automaton, level),
+              count_pieces(a.automaton, level) + count_pieces(j.automaton, level) + count_pieces(b.automaton, level));
+    const MeshCounts c = counts(tessellate_surface(all, level));
+    EXPECT_EQ(c.vertices - c.edges + c.faces, 1) << "level " << level;
+    const MeshCounts cj = counts(tessellate_surface(j, level));
+    EXPECT_EQ(cj.vertices - cj.edges + cj.faces, 1) << "level " << level;
+    EXPECT_EQ(c.boundary, 2 * (1L << level) + 2 * long(count_pieces(all.automaton, level) >> level)) << "level " << level;
+  }
+}
+
+// A curve automaton on three points that splits its quadratic Bezier arc at t = 0.3 (de Casteljau):
+// a straight segment drawn with it has unequal pieces.
+Automaton bezier_split(double t) {
+  Eigen::MatrixXd left = Eigen::MatrixXd::Zero(3, 3), right = Eigen::MatrixXd::Zero(3, 3);
+  left.col(0) << 1, 0, 0;
+  left.col(1) << 1 - t, t, 0;
+  left.col(2) << (1 - t) * (1 - t), 2 * t * (1 - t), t * t;
+  right.col(0) = left.col(2);
+  right.col(1) << 0, 1 - t, t;
+  right.col(2) << 0, 0, 1;
+  Automaton a;
+  State st;
+  st.name = "bezier";
+  st.control_points = 3;
+  a.states.push_back(st);
+  a.transitions.push_back({Transition{0, 0, left}, Transition{1, 0, right}});
+  return a;
+}
+
+TEST(Junction, RefusesUAutomataThatCannotMeetAndBadOptions) {
+  JunctionSides s = shared_polygon_sides();
+  TensorSurface uneven = s.b;
+  uneven.u = bezier_split(0.3);
+  try {
+    junction(s.a, uneven, JunctionOptions{});
+    FAIL() << "a u automaton without equal pieces on a segment was accepted";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("linear precision"), std::string::npos) << e.what();
+  }
+  // Halves of a Bezier arc do have linear precision: accepted.
+  TensorSurface even = s.b;
+  even.u = bezier_split(0.5);
+  EXPECT_NO_THROW(junction(s.a, even, JunctionOptions{}));
+  TensorSurface cubic = s.b;  // a u automaton on four points: the borders cannot share A's polygon
+  cubic.u = nurbs_automaton(3, {0, 1, 2, 3, 4, 5}).automaton;
+  cubic.control_points.conservativeResize(3, 12);
+  EXPECT_THROW(junction(s.a, cubic, JunctionOptions{}), InvalidInput);
   JunctionOptions wide;
   wide.ratio = 0.5;
   EXPECT_THROW(junction(s.a, s.b, wide), InvalidInput);
-  TensorSurface touching = s.b;  // B starting on A's end (the uniform quadratic piece ends mid-way on its last leg)
+  const JunctionSides same_u = junction_sides();
+  TensorSurface touching = same_u.b;  // B starting on A's end (the uniform quadratic piece ends mid-way on its last leg)
   for (int i = 0; i < 3; ++i) {
-    const Eigen::Vector3d shift =
-        0.5 * (s.a.control_points.col(i * 3 + 1) + s.a.control_points.col(i * 3 + 2)) - s.b.control_points.col(i * 3);
+    const Eigen::Vector3d shift = 0.5 * (same_u.a.control_points.col(i * 3 + 1) + same_u.a.control_points.col(i * 3 + 2)) -
+                                  same_u.b.control_points.col(i * 3);
     for (int l = 0; l < 3; ++l) touching.control_points.col(i * 3 + l) += shift;
   }
-  EXPECT_THROW(junction(s.a, touching, JunctionOptions{}), InvalidInput);
+  EXPECT_THROW(junction(same_u.a, touching, JunctionOptions{}), InvalidInput);
 }
 
 TEST(Junction, ReadFromJsonWithTheSidesAsSystems) {
@@ -491,13 +625,16 @@ TEST(Junction, ReadFromJsonWithTheSidesAsSystems) {
   } catch (const InvalidInput& e) {
     EXPECT_NE(std::string(e.what()).find("ratio"), std::string::npos) << e.what();
   }
+  // B of another u automaton (uniform knots): J gains the two free points per point of u.
   system["junction"]["ratio"] = 0.25;
   system["junction"]["b"]["product"][0]["nurbs_curve"]["knots"] = {0, 1, 2, 3};
+  EXPECT_EQ(parse_system(system, "r.json", "system").control_points.cols(), 3 * 8);
+  system["junction"]["b"]["product"][0] = "koch_curve";
   try {
     parse_system(system, "r.json", "system");
-    FAIL() << "sides of different u automata were accepted";
+    FAIL() << "sides whose u automata cannot meet were accepted";
   } catch (const InvalidInput& e) {
-    EXPECT_NE(std::string(e.what()).find("u automaton"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("junction"), std::string::npos) << e.what();
   }
 }
 

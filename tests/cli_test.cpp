@@ -877,8 +877,8 @@ TEST(Cli, CifsShellStandsOnItsOwnSupportTree) {
   // A bi-quadratic roof between z = 11.17 and 14, alone and on its level-3 tree rooted at z = 0: both one
   // solid, the supported one reaching down to the plate; a base above the roof is refused and writes nothing.
   TempDir dir;
-  auto roof = [&](const std::string& name, const std::string& support) {
-    write_file(dir / (name + ".json"), R"({"voxel_size_mm": 0.15, "inputs": {"roof": {"type": "cifs", "level": 3,
+  auto roof = [&](const std::string& name, const std::string& support, const std::string& type = "cifs") {
+    write_file(dir / (name + ".json"), R"({"voxel_size_mm": 0.15, "inputs": {"roof": {"type": ")" + type + R"(", "level": 3,
         "thickness_mm": 0.8, "system": {"nurbs_surface": {"u": {"degree": 2, "knots": [0, 1, 3, 4]},
         "v": {"degree": 2, "knots": [0, 1, 2, 3]}}, "control_points_mm": [[[0, 0, 10], [0, 8, 10], [0, 16, 10]],
         [[10, 0, 11], [10, 8, 16], [10, 16, 11]], [[20, 0, 12], [20, 8, 12], [20, 16, 12]]]})" + support + R"(}},
@@ -896,6 +896,16 @@ TEST(Cli, CifsShellStandsOnItsOwnSupportTree) {
   EXPECT_GT(a["bounding_box_mm"]["min"][2].get<double>(), 10.5);
   EXPECT_NEAR(s["bounding_box_mm"]["min"][2].get<double>(), 0.0, 0.15);  // the root's base on the plate
   EXPECT_GT(s["volume_mm3"].get<double>(), a["volume_mm3"].get<double>() + 3 * 3 * 11.0 / 4);  // more than a thin trunk
+  // The same part as a cifs_support input (the support's keys beside the shell's): the same triangles
+  // (the 80-byte header names the recipe).
+  Result input = roof("input", R"(, "base_mm": [10, 8, 0], "base_size_mm": 3)", "cifs_support");
+  ASSERT_EQ(input.code, 0) << input.err;
+  const std::string by_input = read_file(dir / "input" / "roof.stl"), by_key = read_file(dir / "supported" / "roof.stl");
+  ASSERT_GT(by_key.size(), 84u);
+  EXPECT_TRUE(by_input.substr(80) == by_key.substr(80)) << by_input.size() << " and " << by_key.size() << " bytes";
+  Result no_base = roof("no_base", "", "cifs_support");
+  EXPECT_EQ(no_base.code, 2);
+  EXPECT_NE(no_base.err.find("base_mm"), std::string::npos) << no_base.err;
   Result above = roof("above", R"(, "support": {"base_mm": [10, 8, 12]})");
   EXPECT_EQ(above.code, 2);
   EXPECT_NE(above.err.find("support"), std::string::npos) << above.err;

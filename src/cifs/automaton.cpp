@@ -31,14 +31,14 @@ int natural_vertex_count(Primitive p) {
   }
 }
 
+}  // namespace
+
 Eigen::MatrixXd kronecker(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   Eigen::MatrixXd out(a.rows() * b.rows(), a.cols() * b.cols());
   for (Eigen::Index i = 0; i < a.rows(); ++i)
     for (Eigen::Index j = 0; j < a.cols(); ++j) out.block(i * b.rows(), j * b.cols(), b.rows(), b.cols()) = a(i, j) * b;
   return out;
 }
-
-}  // namespace
 
 Primitive primitive_from_name(const std::string& name) {
   static const std::map<std::string, Primitive> kNames = {

@@ -96,6 +96,9 @@ FixedPointFrame limit_frame(const Automaton& automaton, int state, int symbol, i
 // last symbol repeated), for quads of a tensor product the four corners. Fills State::vertices.
 void complete_primitives(Automaton& automaton);
 
+// The Kronecker product (row i_a * rows(b) + i_b, column j_a * cols(b) + j_b): the matrices of a tensor product.
+Eigen::MatrixXd kronecker(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b);
+
 // Tensor product: states are the pairs reachable from the two initial states, symbols pairs
 // (a * |B| + b), matrices Kronecker products (control point index i_a * k_b + i_b).
 Automaton tensor_product(const Automaton& a, const Automaton& b);

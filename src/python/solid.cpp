@@ -392,7 +392,11 @@ const char* kInputDocs[][2] = {
      "solid), layout (tiled, scaled, conforming), inset_mm."},
     {"cifs",
      "The attractor of a controlled IFS: system (a shipped name or a system dict), level (3), as (tubes, shell, cells, "
-     "edges), radius_mm, thickness_mm, fit_to (an input solid)."},
+     "edges), radius_mm, thickness_mm, fit_to (an input solid), support ({base_mm, base_size_mm, fork, shrink}: a "
+     "shell on its own fractal tree)."},
+    {"cifs_support",
+     "A cifs shell on its own fractal tree: system, level, thickness_mm, fit_to, with base_mm, base_size_mm, fork "
+     "(0.5), shrink (0.5)."},
     {"curve",
      "Superimposed space-filling curves as tubes: kind (hilbert, sierpinski, hilbert3d), orders (\"1..5\" or a list), "
      "radius_mm, scale_mm, surface (plane, sphere, cylinder, torus, cone, cube, bspline, mesh), patch, mesh, "

@@ -19,6 +19,8 @@ MeshInput parse_mesh_input(const JsonObject& o);
 SurfaceInput parse_surface_input(const JsonObject& o);
 LatticeInput parse_lattice_input(const JsonObject& o);
 CifsInput parse_cifs_input(const JsonObject& o);
+// A cifs shell on its own support tree: the keys of a cifs shell with those of its "support" beside them.
+CifsInput parse_cifs_support_input(const JsonObject& o);
 CurveInput parse_curve_input(const JsonObject& o);
 FillMotifsInput parse_fill_motifs_input(const JsonObject& o);
 FillSpheresInput parse_fill_spheres_input(const JsonObject& o);

@@ -142,6 +142,29 @@ LatticeInput parse_lattice_input(const JsonObject& o) {
   return in;
 }
 
+namespace {
+
+// The tree under a cifs shell: the keys of `so` (the "support" object, or a cifs_support input itself);
+// `o` names the input in messages.
+void read_support(const JsonObject& o, const JsonObject& so, const char* key, CifsInput& in) {
+  if (in.solid.as != cifs::SolidOptions::As::kDefault && in.solid.as != cifs::SolidOptions::As::kShell)
+    o.fail(key, "a support stands under a shell: leave \"as\" out or give \"shell\"");
+  for (const cifs::State& s : in.system.automaton.states)
+    if (s.primitive != cifs::Primitive::kQuad)
+      o.fail(key, "a support stands under a tensor surface (quad pieces); state \"" + s.name + "\" is a " +
+                      cifs::primitive_name(s.primitive));
+  cifs::SupportOptions support;
+  support.base_center_mm = so.vec3("base_mm");
+  if (so.has("base_size_mm")) support.base_size_mm = so.positive_length("base_size_mm");
+  support.fork = so.number_or("fork", support.fork);
+  if (!(support.fork > 0 && support.fork < 1)) so.fail("fork", "expected a number strictly between 0 and 1");
+  support.shrink = so.number_or("shrink", support.shrink);
+  if (!(support.shrink > 0 && support.shrink <= 1)) so.fail("shrink", "expected a number in (0, 1]");
+  in.support = support;
+}
+
+}  // namespace
+
 CifsInput parse_cifs_input(const JsonObject& o) {
   CifsInput in;
   in.system = cifs::parse_system(o.required("system"), o.file(), o.path_of("system"));
@@ -161,21 +184,15 @@ CifsInput parse_cifs_input(const JsonObject& o) {
   if (o.has("support")) {
     JsonObject so = o.object("support");
     so.allow_only({"base_mm", "base_size_mm", "fork", "shrink"});
-    if (options.as != cifs::SolidOptions::As::kDefault && options.as != cifs::SolidOptions::As::kShell)
-      o.fail("support", "a support stands under a shell: leave \"as\" out or give \"shell\"");
-    for (const cifs::State& s : in.system.automaton.states)
-      if (s.primitive != cifs::Primitive::kQuad)
-        o.fail("support", "a support stands under a tensor surface (quad pieces); state \"" + s.name + "\" is a " +
-                              cifs::primitive_name(s.primitive));
-    cifs::SupportOptions support;
-    support.base_center_mm = so.vec3("base_mm");
-    if (so.has("base_size_mm")) support.base_size_mm = so.positive_length("base_size_mm");
-    support.fork = so.number_or("fork", support.fork);
-    if (!(support.fork > 0 && support.fork < 1)) so.fail("fork", "expected a number strictly between 0 and 1");
-    support.shrink = so.number_or("shrink", support.shrink);
-    if (!(support.shrink > 0 && support.shrink <= 1)) so.fail("shrink", "expected a number in (0, 1]");
-    in.support = support;
+    read_support(o, so, "support", in);
   }
+  return in;
+}
+
+CifsInput parse_cifs_support_input(const JsonObject& o) {
+  CifsInput in = parse_cifs_input(o);
+  in.solid.as = cifs::SolidOptions::As::kShell;
+  read_support(o, o, "system", in);
   return in;
 }
 

@@ -58,6 +58,8 @@ const std::map<std::string, InputType>& types() {
               {"cell", "period_mm", "strut_radius_mm", "min_mm", "max_mm", "fit_to", "grade", "layout", "inset_mm"},
               parse_as<LatticeInput, parse_lattice_input>},
              {"cifs", {"system", "level", "as", "radius_mm", "thickness_mm", "fit_to", "support"}, parse_as<CifsInput, parse_cifs_input>},
+             {"cifs_support", {"system", "level", "thickness_mm", "fit_to", "base_mm", "base_size_mm", "fork", "shrink"},
+              parse_as<CifsInput, parse_cifs_support_input>},
              {"curve",
               {"kind", "orders", "radius_mm", "surface", "patch", "mesh", "scale_mm", "center_mm", "offset_mm", "tolerance_mm",
                "base_mm"},
