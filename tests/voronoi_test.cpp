@@ -539,6 +539,26 @@ TEST(VoronoiRefine, TilesPartitionTheTorusAndMatchTheRuleCounts) {
   EXPECT_THROW(voronoi::refine_level(rules, -1, 1, [](const std::vector<double>&, int) { return false; }), InvalidInput);
 }
 
+// The field is asked at each tile's generator where its compact tile lies: the unwrapped position, outside the
+// unit period for a tile across the torus seam (a field read at the wrapped one would refine it elsewhere).
+TEST(VoronoiRefine, TheFieldIsReadAtTheUnwrappedGenerator) {
+  const Rules rules = voronoi::make_rules(2, 2, kExample, scaled());
+  const Level one = voronoi::generate_level(rules, 1, true);
+  ASSERT_EQ(one.unwrapped.size(), one.points.size());
+  int outside = 0;
+  for (const auto& u : one.unwrapped) outside += (u[0] < 0 || u[0] >= 1 || u[1] < 0 || u[1] >= 1);
+  ASSERT_GT(outside, 0);  // some level-1 generators lie across the seam
+  ASSERT_LT(outside, int(one.points.size()));
+  std::vector<std::vector<double>> asked;
+  const voronoi::RefinedLevel r = voronoi::refine_level(rules, 1, 2, [&](const std::vector<double>& x, int l) {
+    if (l == 0) return true;
+    asked.push_back(x);
+    return x[0] < 0 || x[0] >= 1 || x[1] < 0 || x[1] >= 1;
+  });
+  EXPECT_EQ(asked, one.unwrapped);  // every level-1 generator asked once, in the recursion's order, unwrapped
+  EXPECT_EQ(r.tiles_per_level, (std::vector<int>{0, int(one.points.size()) - outside, 4 * outside}));
+}
+
 // Without a gap the compact tiles hold exactly the cell measure of their colour, and together a fundamental
 // domain of the torus (measure 1); with a gap, tiles + gap (wall measure x width) still make 1 up to the
 // corners where walls meet.

@@ -499,14 +499,18 @@ class Builder {
 
   // `refine` (voronoi_tiles, voronoi_foam): the partition's fractal cells, each replaced by its children while
   // the field at its generator asks for it, every tile drawn with `level` levels of detail; part.level's colours
-  // become the tiles. Returns the tiles' starting colours and counts per level.
+  // become the tiles. Returns the tiles' starting colours and counts per level. The field is read at each tile's
+  // generator where the tile is drawn: compact tiles (keep_unwrapped) at its unwrapped position, the foam's
+  // periodic walls in the period at the origin.
   voronoi::RefinedLevel refine(Partition& part, const VoronoiPartition& partition, const GradeField& field,
                                int levels, bool keep_unwrapped) {
     const voronoi::TorusPlacement& place = part.place;
     try {
       voronoi::RefinedLevel refined = voronoi::refine_level(
           part.rules, partition.level, levels,
-          [&](const std::vector<double>& x, int l) {
+          [&](const std::vector<double>& u, int l) {
+            double x[3] = {0, 0, 0};
+            for (size_t j = 0; j < u.size() && j < 3; ++j) x[j] = keep_unwrapped ? u[j] : u[j] - std::floor(u[j]);
             const Vec3d p = place.to_mm(x[0], x[1], place.dimension == 3 ? x[2] : 0.0);
             return field.at(p) > double(l + 1) / double(levels + 1);
           },

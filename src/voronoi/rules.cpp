@@ -386,9 +386,7 @@ struct Refiner {
   // so far, not yet a tile).
   void visit(int i, int s, int c, const std::vector<double>& p, int tile) {
     if (tile < 0) {
-      std::vector<double> x(p.size());
-      for (size_t j = 0; j < p.size(); ++j) x[j] = wrap(p[j]);
-      if (i == levels || !(*refine)(x, i)) {
+      if (i == levels || !(*refine)(p, i)) {
         tile = int(out.tile_level.size());
         out.tile_level.push_back(i);
         out.tile_shape.push_back(c);

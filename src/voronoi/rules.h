@@ -84,8 +84,8 @@ Level generate_level(const Rules& rules, int k, bool keep_unwrapped = false);
 // A tiling of non-uniform density (quasi-periodic tilings: every tile is the union of its children, the
 // tiles of the next level scaled by 1/d). A point of P^l carries one tile of level l, the union of the cells
 // of its descendants; the tiles of level 0 are the partition's m fractal cells. Starting from them, a tile of
-// level l < levels is replaced by its children while refine(x, l) says so, x the tile's generator (wrapped
-// into [0,1)^n). Every tile is drawn with `detail` more levels, so the level is generated to detail + levels
+// level l < levels is replaced by its children while refine(x, l) says so, x the tile's generator at its
+// unwrapped position (where the compact tile lies: it may be just outside [0,1)^n; wrap it for the torus). Every tile is drawn with `detail` more levels, so the level is generated to detail + levels
 // with scaled children, and each of its points is coloured by the tile it ends in: `level.colours` are tile
 // indices (colour_count the number of tiles, in the order of the spec's recursion), so walls between colours
 // are the walls between tiles, closed across every change of resolution because all of them are faces of one
