@@ -997,6 +997,50 @@ TEST(Cli, VoronoiFoamRefinedWhereTheFieldIsHigh) {
   EXPECT_GT(refined.high, 2 * (refined.cavities - refined.high));
 }
 
+TEST(Cli, VoronoiFoamRefinedOverPeriodsWhereEachTileLies) {
+  // The foam above over two periods along x (a 24 mm box, "tiles" [2, 1, 1], and again as "cover" of the
+  // box) with a ramp across both asking for a split where x > 12 mm: the copies of the tiles in the second
+  // period split and those in the first do not (read per period, both halves would be alike), one closed
+  // solid across the seam between them.
+  TempDir dir;
+  auto run = [&](const std::string& name, const std::string& periods) {
+    write_file(dir / (name + ".json"), R"({"voxel_size_mm": 0.2, "inputs": {"foam": {"type": "voronoi_foam",
+        "dimension": 3, "d": 2, "points": [[0.12, 0.31, 0.77], [0.58, 0.22, 0.41], [0.36, 0.84, 0.18], [0.81, 0.63, 0.59]],
+        "period_mm": 12, "wall_mm": 0.5, "level": 1, )" + periods + R"(, "refine": {"field": "ramp", "axis": [1, 0, 0],
+        "from_mm": 0, "to_mm": 24, "levels": 1}},
+        "box": {"type": "box", "min_mm": [0, 0, 0], "max_mm": [24, 12, 12]}},
+        "operations": [{"name": "skin", "op": "shell", "of": "box", "thickness_mm": 0.6},
+          {"name": "inside", "op": "intersection", "of": ["box", "foam"]},
+          {"name": "part", "op": "union", "of": ["skin", "inside"]}],
+        "outputs": [{"of": "part", "file": "foam.stl"}]})");
+    Result r = lacuna("run " + quote((dir / (name + ".json")).string()) + " -o " + quote((dir / name).string()) + " --json",
+                      dir.path());
+    EXPECT_EQ(r.code, 0) << r.err;
+    if (r.code != 0) return std::array<int, 3>{0, 0, 0};
+    EXPECT_TRUE(nlohmann::json::parse(r.out)["outputs"][0]["checks"]["valid"].get<bool>());
+    std::array<int, 3> shells{0, 0, 0};  // bodies, cavities centred at x < 12, at x > 12
+    for (const MeshComponent& c : mesh_components(read_mesh((dir / name / "foam.stl").string()))) {
+      if (c.signed_volume_mm3 > 0) ++shells[0];
+      else ++shells[c.centroid_mm.x > 12 ? 2 : 1];
+    }
+    const nlohmann::json report = nlohmann::json::parse(read_file(dir / name / "report.json"))["inputs"]["foam"];
+    EXPECT_GT(report["tiles_per_level"][0].get<int>(), 0) << name;
+    EXPECT_GT(report["tiles_per_level"][1].get<int>(), 0) << name;
+    return shells;
+  };
+  const std::array<int, 3> tiles = run("tiles", R"("tiles": [2, 1, 1])");
+  EXPECT_EQ(tiles[0], 1);
+  EXPECT_GT(tiles[1], 0);
+  EXPECT_GT(tiles[2], 3 * tiles[1]);  // a level-1 tile is an eighth of a level-0 one
+  // Covering the box draws the periods around it too, so walls carried by generators just outside close the
+  // cells along the box's faces; the halves differ alike.
+  const std::array<int, 3> cover = run("cover", R"("cover": "box")");
+  EXPECT_EQ(cover[0], 1);
+  EXPECT_GE(cover[1], tiles[1]);
+  EXPECT_GE(cover[2], tiles[2]);
+  EXPECT_GT(cover[2], 3 * cover[1]);
+}
+
 TEST(Cli, BcifsRulesPlateAndMeasure) {
   TempDir dir;
   Result f0 = lacuna("bcifs rules --boundary " + quote("C2 B2 C2 B2 C2 B2") + " --params " + quote("C2 B2 B2") + " --json",

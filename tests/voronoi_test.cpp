@@ -559,6 +559,82 @@ TEST(VoronoiRefine, TheFieldIsReadAtTheUnwrappedGenerator) {
   EXPECT_EQ(r.tiles_per_level, (std::vector<int>{0, int(one.points.size()) - outside, 4 * outside}));
 }
 
+// A refined tiling over several periods, each copy of a tile refined on its own. With choices that do not
+// depend on the copy (read at the wrapped generator), every period holds refine_level's walls: twice the
+// facets and measure over two periods. Read where each copy lies, the choices follow the field: a copy in the
+// second period splits and one in the first does not, and the result moves with the field and the periods.
+TEST(VoronoiRefine, CopiesOverPeriodsAreRefinedWhereTheyLie) {
+  for (const StartingSet& c : starting_sets(2, 1)) {
+    const Rules rules = voronoi::make_rules(c.n, 2, c.points, scaled());
+    const int detail = 1, levels = 2;
+    auto periodic_rule = [](const std::vector<double>& x, int l) {
+      const double x0 = x[0] - std::floor(x[0]);
+      return x0 < 0.5 || (x0 < 0.75 && l == 0);
+    };
+    const voronoi::Walls periodic = voronoi::extract_walls(rules, voronoi::refine_level(rules, detail, levels, periodic_rule).level);
+    const std::array<int, 3> lo{0, 0, 0}, hi{2, 1, 1};
+    const voronoi::RefinedWalls twice = voronoi::refined_walls(rules, detail, levels, lo, hi, periodic_rule);
+    EXPECT_EQ(twice.walls.facets.size(), 2 * periodic.facets.size()) << c.n;
+    EXPECT_NEAR(twice.walls.measure, 2 * periodic.measure, 1e-9 * periodic.measure) << c.n;
+    for (const auto& f : twice.walls.facets)
+      for (const auto& v : f) EXPECT_TRUE(v[0] > -0.5 && v[0] < 2.5) << c.n;
+
+    // Split where x >= 1: the copies in the second period (level-0 generators are in [0, 1)) split, those
+    // in the first do not.
+    auto second = [](const std::vector<double>& x, int) { return x[0] >= 1; };
+    const voronoi::RefinedWalls ramp = voronoi::refined_walls(rules, detail, 1, lo, hi, second);
+    ASSERT_EQ(ramp.tiles_per_level.size(), 2u);
+    EXPECT_GT(ramp.tiles_per_level[0], 0) << c.n;
+    EXPECT_GT(ramp.tiles_per_level[1], 0) << c.n;
+    const voronoi::RefinedWalls none = voronoi::refined_walls(rules, detail, 1, lo, hi, [](const std::vector<double>&, int) { return false; });
+    const voronoi::RefinedWalls all = voronoi::refined_walls(rules, detail, 1, lo, hi, [](const std::vector<double>&, int) { return true; });
+    EXPECT_EQ(none.tiles_per_level[1], 0);
+    EXPECT_EQ(all.tiles_per_level[0], 0);
+    // The first period's walls are those of no refinement, the second's those of full refinement, up to the
+    // tiles that reach across the seam at x = 1 (and at 0 and 2): compare the measure of the facets wholly
+    // within each period's middle.
+    auto middle = [](const voronoi::Walls& w, double from) {
+      double m = 0;
+      for (size_t f = 0; f < w.facets.size(); ++f) {
+        bool inside = true;
+        for (const auto& v : w.facets[f]) inside = inside && v[0] > from + 0.3 && v[0] < from + 0.7;
+        if (!inside) continue;
+        const auto& q = w.facets[f];
+        if (q.size() == 2) m += std::hypot(q[1][0] - q[0][0], q[1][1] - q[0][1]);
+        else {
+          std::array<double, 3> a{0, 0, 0};
+          for (size_t k = 1; k + 1 < q.size(); ++k) {
+            const double u[3] = {q[k][0] - q[0][0], q[k][1] - q[0][1], q[k][2] - q[0][2]};
+            const double w2[3] = {q[k + 1][0] - q[0][0], q[k + 1][1] - q[0][1], q[k + 1][2] - q[0][2]};
+            a[0] += u[1] * w2[2] - u[2] * w2[1];
+            a[1] += u[2] * w2[0] - u[0] * w2[2];
+            a[2] += u[0] * w2[1] - u[1] * w2[0];
+          }
+          m += 0.5 * std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+        }
+      }
+      return m;
+    };
+    EXPECT_LT(middle(ramp.walls, 0), middle(all.walls, 0)) << c.n;   // coarse where x < 1
+    EXPECT_GT(middle(ramp.walls, 1), middle(none.walls, 1)) << c.n;  // fine where x >= 1
+    EXPECT_NEAR(middle(ramp.walls, 0) + middle(ramp.walls, 1), middle(none.walls, 0) + middle(all.walls, 1),
+                1e-9 * middle(all.walls, 1))
+        << c.n << ": only tiles lying across a seam differ from their period's plain choice";
+    // The same field one period on, over the periods one on: the same walls one period on.
+    auto moved = [](const std::vector<double>& x, int) { return x[0] - 1 >= 1; };
+    const voronoi::RefinedWalls on = voronoi::refined_walls(rules, detail, 1, {1, 0, 0}, {3, 1, 1}, moved);
+    ASSERT_EQ(on.walls.facets.size(), ramp.walls.facets.size()) << c.n;
+    double worst = 0;
+    for (size_t f = 0; f < on.walls.facets.size(); ++f)
+      for (size_t k = 0; k < on.walls.facets[f].size(); ++k) {
+        worst = std::max(worst, std::fabs(on.walls.facets[f][k][0] - 1 - ramp.walls.facets[f][k][0]));
+        for (int j = 1; j < 3; ++j) worst = std::max(worst, std::fabs(on.walls.facets[f][k][size_t(j)] - ramp.walls.facets[f][k][size_t(j)]));
+      }
+    EXPECT_LT(worst, 1e-12) << c.n;
+    EXPECT_EQ(on.tiles_per_level, ramp.tiles_per_level) << c.n;
+  }
+}
+
 // Without a gap the compact tiles hold exactly the cell measure of their colour, and together a fundamental
 // domain of the torus (measure 1); with a gap, tiles + gap (wall measure x width) still make 1 up to the
 // corners where walls meet.

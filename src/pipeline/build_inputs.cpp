@@ -551,35 +551,53 @@ class Builder {
     out_.report = report;
   }
 
-  // Foam: the walls between colours thickened, repeated over whole periods (clip it with an intersection).
+  // Foam: the walls between colours thickened, repeated over whole periods (clip it with an intersection). With
+  // `refine`, every copy of a tile is refined where it lies (the field read at its generator there).
   void add(const VoronoiFoamInput& v) {
     Partition part = partition(v.refine_levels ? with_level(v.partition, 0) : v.partition, false);
-    std::vector<int> tiles_per_level;
-    if (v.refine_levels) tiles_per_level = refine(part, v.partition, v.refine, v.refine_levels, false).tiles_per_level;
-    const voronoi::Walls walls = voronoi::extract_walls(part.rules, part.level);
-    VoronoiWallsReport report = walls_report(part, walls);
-    report.tiles_per_level = tiles_per_level;
-    out_.report = report;
-    part.level = voronoi::Level();  // the walls are all that is needed from here on
     const voronoi::TorusPlacement& place = part.place;
-    if (!v.cover) {
-      voronoi::add_foam(place, walls, {0, 0, 0}, v.tiles, v.wall_mm, v.thickness_mm, out_.geometry);
-      return;
+    // The periods drawn: the tiles, or every period that meets the covered input's box (walls reach a little
+    // past their own period).
+    std::array<int, 3> a{0, 0, 0}, b = v.tiles;
+    if (v.cover) {
+      const Box3 box = box_of(*v.cover);
+      const Vec3d lo = (box.min - place.origin_mm) / place.period_mm;
+      const Vec3d hi = (box.max - place.origin_mm) / place.period_mm;
+      a = {int(std::floor(lo.x)) - 1, int(std::floor(lo.y)) - 1, int(std::floor(lo.z)) - 1};
+      b = {int(std::ceil(hi.x)) + 1, int(std::ceil(hi.y)) + 1, int(std::ceil(hi.z)) + 1};
     }
-    // Every period that meets the covered input's box (walls reach a little past their own period).
-    const Box3 box = box_of(*v.cover);
-    const Vec3d lo = (box.min - place.origin_mm) / place.period_mm;
-    const Vec3d hi = (box.max - place.origin_mm) / place.period_mm;
-    std::array<int, 3> a{int(std::floor(lo.x)) - 1, int(std::floor(lo.y)) - 1, int(std::floor(lo.z)) - 1};
-    std::array<int, 3> b{int(std::ceil(hi.x)) + 1, int(std::ceil(hi.y)) + 1, int(std::ceil(hi.z)) + 1};
     if (place.dimension == 2) {
       a[2] = 0;
       b[2] = 1;
     }
     const double periods = double(b[0] - a[0]) * (b[1] - a[1]) * (b[2] - a[2]);
+    if (v.refine_levels) {
+      voronoi::RefinedWalls refined;
+      const int levels = v.refine_levels;
+      try {
+        refined = voronoi::refined_walls(part.rules, v.partition.level, levels, a, b,
+                                         [&](const std::vector<double>& x, int l) {
+                                           const Vec3d p = place.to_mm(x[0], x[1], place.dimension == 3 ? x[2] : 0.0);
+                                           return v.refine.at(p) > double(l + 1) / double(levels + 1);
+                                         });
+      } catch (const InvalidInput& e) {
+        fail("refine", e.what());
+      } catch (const ResourceLimit& e) {
+        throw ResourceLimit(where() + (v.cover ? ".cover: " : ".refine: ") + e.what());
+      }
+      VoronoiWallsReport report = walls_report(part, refined.walls);
+      report.tiles_per_level = refined.tiles_per_level;
+      out_.report = report;
+      voronoi::add_foam(place, refined.walls, {0, 0, 0}, {1, 1, 1}, v.wall_mm, v.thickness_mm, out_.geometry);
+      return;
+    }
+    const voronoi::Walls walls = voronoi::extract_walls(part.rules, part.level);
+    out_.report = walls_report(part, walls);
+    part.level = voronoi::Level();  // the walls are all that is needed from here on
     if (periods * double(walls.facets.size()) > 5e7)
-      throw ResourceLimit(where() + ".cover: covering it takes " + std::to_string(int64_t(periods)) + " periods of " +
-                          std::to_string(walls.facets.size()) + " walls; use a larger period_mm");
+      throw ResourceLimit(where() + (v.cover ? ".cover: covering it takes " : ": the tiles take ") +
+                          std::to_string(int64_t(periods)) + " periods of " + std::to_string(walls.facets.size()) +
+                          " walls; use a larger period_mm");
     voronoi::add_foam(place, walls, a, b, v.wall_mm, v.thickness_mm, out_.geometry);
   }
 

@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <stdexcept>
 #include <string>
+
+#include <tbb/parallel_for.h>
 
 #include "errors.h"
 #include "voronoi/clip.h"
@@ -27,6 +30,7 @@ struct Lattice {
   int64_t D = 1;
   int64_t cells = 1;                 // D^n
   std::vector<int> colour_of_key;    // m D^n entries
+  std::vector<int> generator_of_key; // m D^n entries
   std::vector<int64_t> key;          // per generator
   std::vector<std::array<int64_t, 3>> z;  // per generator
 
@@ -62,6 +66,7 @@ Lattice make_lattice(const Rules& rules, const Level& level) {
   lattice.D = D;
   lattice.cells = cells;
   lattice.colour_of_key.assign(size_t(cells) * m, -1);
+  lattice.generator_of_key.assign(size_t(cells) * m, -1);
   lattice.key.resize(level.points.size());
   lattice.z.resize(level.points.size());
   for (size_t i = 0; i < level.points.size(); ++i) {
@@ -80,6 +85,7 @@ Lattice make_lattice(const Rules& rules, const Level& level) {
       throw InvalidInput("voronoi walls: two generators share lattice site " + std::to_string(k) +
                          " (use children \"scaled\")");
     lattice.colour_of_key[size_t(k)] = level.colours[i];
+    lattice.generator_of_key[size_t(k)] = int(i);
     lattice.key[i] = k;
     lattice.z[i] = zz;
   }
@@ -89,45 +95,239 @@ Lattice make_lattice(const Rules& rules, const Level& level) {
 // The periodic cells of the starting points (level 0), each face with its neighbour and shift.
 std::vector<Cell> shape_cells(const Rules& rules) { return periodic_cells(generate_level(rules, 0)); }
 
-}  // namespace
-
-Walls extract_walls(const Rules& rules, const Level& level) {
-  const Lattice lattice = make_lattice(rules, level);
-  const std::vector<Cell> cells = shape_cells(rules);
+// Every face between two generators of a scaled level that wanted(i, j, shift) asks for (symmetric: the
+// same answer from j with -shift), once, from the generator of the lower lattice key: emit(i, j, shift,
+// facet) with the facet around i's wrapped position and shift the whole periods from i's wrapped copy to
+// the copy of j across the face. Returns how many generators had a face asked for.
+template <class Wanted, class Emit>
+size_t scan_faces(const Rules& rules, const Level& level, const Lattice& lattice, const std::vector<Cell>& cells,
+                  Wanted&& wanted, Emit&& emit) {
   const int n = rules.dimension;
   const double scale = 1.0 / double(lattice.D);
-  Walls walls;
-  walls.dimension = n;
-  walls.points = level.points.size();
+  size_t boundary_generators = 0;
   for (size_t i = 0; i < level.points.size(); ++i) {
     const int shape = level.shapes[i];
     const Cell& cell = cells[size_t(shape)];
-    const int colour = level.colours[i];
     const auto& x = level.points[i];
     const auto& p = rules.points[size_t(shape)];
     bool boundary = false;
     for (size_t f = 0; f < cell.faces.size(); ++f) {
       const Neighbour& nb = cell.across[f];
       std::array<int64_t, 3> zz{0, 0, 0};
-      for (int j = 0; j < n; ++j) zz[size_t(j)] = modulo(lattice.z[i][size_t(j)] + nb.shift[size_t(j)], lattice.D);
+      std::array<int, 3> shift{0, 0, 0};
+      for (int j = 0; j < n; ++j) {
+        const int64_t raw = lattice.z[i][size_t(j)] + nb.shift[size_t(j)];
+        zz[size_t(j)] = modulo(raw, lattice.D);
+        shift[size_t(j)] = int((raw - zz[size_t(j)]) / lattice.D);
+      }
       const int64_t other_key = lattice.key_of(nb.generator, zz);
-      const int other = lattice.colour_of_key[size_t(other_key)];
-      if (other == colour) continue;
+      const size_t other = size_t(lattice.generator_of_key[size_t(other_key)]);
+      if (!wanted(i, other, shift)) continue;
       boundary = true;
-      if (other_key < lattice.key[i]) continue;  // the neighbour carries this wall
+      if (other_key < lattice.key[i]) continue;  // the neighbour carries this face
       std::vector<Point3> facet;
       for (const Point3& v : cell.faces[f]) {
         Point3 q{0, 0, 0};
         for (int j = 0; j < n; ++j) q[size_t(j)] = x[size_t(j)] + (v[size_t(j)] - p[size_t(j)]) * scale;
         facet.push_back(q);
       }
-      walls.measure += facet_measure(facet, n);
-      walls.facets.push_back(std::move(facet));
-      walls.colours.push_back({colour, other});
+      emit(i, other, shift, std::move(facet));
     }
-    if (boundary) ++walls.boundary_generators;
+    if (boundary) ++boundary_generators;
   }
+  return boundary_generators;
+}
+
+}  // namespace
+
+Walls extract_walls(const Rules& rules, const Level& level) {
+  const Lattice lattice = make_lattice(rules, level);
+  const std::vector<Cell> cells = shape_cells(rules);
+  const int n = rules.dimension;
+  Walls walls;
+  walls.dimension = n;
+  walls.points = level.points.size();
+  walls.boundary_generators = scan_faces(
+      rules, level, lattice, cells,
+      [&](size_t i, size_t j, const std::array<int, 3>&) { return level.colours[i] != level.colours[j]; },
+      [&](size_t i, size_t j, const std::array<int, 3>&, std::vector<Point3>&& facet) {
+        walls.measure += facet_measure(facet, n);
+        walls.facets.push_back(std::move(facet));
+        walls.colours.push_back({level.colours[i], level.colours[j]});
+      });
   return walls;
+}
+
+RefinedWalls refined_walls(const Rules& rules, int detail, int levels, const std::array<int, 3>& lo,
+                           const std::array<int, 3>& hi,
+                           const std::function<bool(const std::vector<double>& x, int l)>& refine) {
+  if (detail < 0 || levels < 0)
+    throw InvalidInput("voronoi: a refined level needs detail >= 0 and levels >= 0, got " + std::to_string(detail) +
+                       " and " + std::to_string(levels));
+  const int n = rules.dimension;
+  for (int k = 0; k < 3; ++k)
+    if (hi[size_t(k)] <= lo[size_t(k)] || (k >= n && hi[size_t(k)] - lo[size_t(k)] != 1))
+      throw InvalidInput("voronoi: the periods to refine over must be a non-empty box (one period along unused axes)");
+  // The fine level with each point's deepest tile (its node of level `levels`, the recursion's order) as
+  // its colour.
+  const Level fine = refine_level(rules, detail, levels, [](const std::vector<double>&, int) { return true; }, true).level;
+  const Lattice lattice = make_lattice(rules, fine);
+  const std::vector<Cell> cells = shape_cells(rules);
+  // Whole periods from each generator's wrapped position to its unwrapped one (where its tile lies).
+  std::vector<std::array<int, 3>> s(fine.points.size(), {0, 0, 0});
+  std::array<int, 3> smin{0, 0, 0}, smax{0, 0, 0};
+  for (size_t i = 0; i < fine.points.size(); ++i)
+    for (int k = 0; k < n; ++k) {
+      s[i][size_t(k)] = int(std::lround(fine.unwrapped[i][size_t(k)] - fine.points[i][size_t(k)]));
+      smin[size_t(k)] = std::min(smin[size_t(k)], s[i][size_t(k)]);
+      smax[size_t(k)] = std::max(smax[size_t(k)], s[i][size_t(k)]);
+    }
+  // The recursion's nodes of levels 0 .. levels (the tiles a point can end in), in its order (global ids
+  // node_offset[l] + j), and every deepest node's ancestors: a node's children follow it in the next
+  // level, as many as its shape's rules.
+  std::vector<Level> nodes;
+  std::vector<int64_t> node_offset{0};
+  for (int l = 0; l <= levels; ++l) {
+    nodes.push_back(generate_level(rules, l, true));
+    node_offset.push_back(node_offset.back() + int64_t(nodes.back().points.size()));
+  }
+  const size_t deepest_count = nodes.back().points.size();
+  std::vector<std::vector<int64_t>> ancestor(size_t(levels) + 1, std::vector<int64_t>(deepest_count));
+  {
+    std::vector<int64_t> parent_of_next;  // per node of level l + 1: its parent in level l
+    std::vector<std::vector<int64_t>> parent(size_t(levels) + 1);
+    for (int l = 0; l < levels; ++l) {
+      auto& next = parent[size_t(l) + 1];
+      for (size_t j = 0; j < nodes[size_t(l)].points.size(); ++j)
+        for (size_t c = 0; c < rules.rules[size_t(nodes[size_t(l)].shapes[j])].size(); ++c) next.push_back(int64_t(j));
+      if (next.size() != nodes[size_t(l) + 1].points.size()) throw std::logic_error("voronoi: the levels' sizes disagree");
+    }
+    for (size_t k = 0; k < deepest_count; ++k) {
+      int64_t j = int64_t(k);
+      for (int l = levels; l >= 0; --l) {
+        ancestor[size_t(l)][k] = j;
+        if (l > 0) j = parent[size_t(l)][size_t(j)];
+      }
+    }
+  }
+  const int64_t split_nodes = node_offset[size_t(levels)];  // nodes of levels < levels: the ones asked
+  // Every copy of the tiling that reaches the periods: anchors a with a + s + (a neighbour's shift) inside.
+  std::array<int, 3> amin{0, 0, 0}, acount{1, 1, 1};
+  int64_t anchors = 1;
+  for (int k = 0; k < n; ++k) {
+    amin[size_t(k)] = lo[size_t(k)] - smax[size_t(k)] - 1;
+    acount[size_t(k)] = (hi[size_t(k)] - smin[size_t(k)] + 1) - amin[size_t(k)];
+    anchors *= acount[size_t(k)];
+  }
+  if (double(anchors) * double(std::max<int64_t>(split_nodes, 1)) > 2e8 ||
+      double(anchors) * double(node_offset.back()) > 2e9)
+    throw ResourceLimit("voronoi: refining " + std::to_string(anchors) + " copies of " + std::to_string(split_nodes) +
+                        " tiles each is too much; use a larger period or fewer refinement levels");
+  auto anchor_index = [&](const std::array<int, 3>& a) {
+    int64_t index = 0;
+    for (int k = n - 1; k >= 0; --k) index = index * acount[size_t(k)] + (a[size_t(k)] - amin[size_t(k)]);
+    return index;
+  };
+  // Whether the copy at anchor a of node j of level l < levels splits: asked once, in parallel.
+  std::vector<uint8_t> split(size_t(anchors * split_nodes), 0);
+  tbb::parallel_for(int64_t(0), anchors, [&](int64_t index) {
+    std::array<int, 3> a{0, 0, 0};
+    int64_t rest = index;
+    for (int k = 0; k < n; ++k) {
+      a[size_t(k)] = amin[size_t(k)] + int(rest % acount[size_t(k)]);
+      rest /= acount[size_t(k)];
+    }
+    std::vector<double> x(static_cast<size_t>(n), 0.0);
+    for (int l = 0; l < levels; ++l)
+      for (size_t j = 0; j < nodes[size_t(l)].unwrapped.size(); ++j) {
+        for (int k = 0; k < n; ++k) x[size_t(k)] = nodes[size_t(l)].unwrapped[j][size_t(k)] + a[size_t(k)];
+        split[size_t(index * split_nodes + node_offset[size_t(l)] + int64_t(j))] = refine(x, l) ? 1 : 0;
+      }
+  });
+  // The tile (global node id) point i ends in, in the copy at anchor index ai.
+  auto tile_of = [&](int64_t ai, size_t i) {
+    const size_t k = size_t(fine.colours[i]);
+    for (int l = 0;; ++l) {
+      const int64_t j = ancestor[size_t(l)][k];
+      if (l == levels || !split[size_t(ai * split_nodes + node_offset[size_t(l)] + j)]) return node_offset[size_t(l)] + j;
+    }
+  };
+  // Faces that can be walls in some copy: between points of different deepest tiles, or of copies of one
+  // that meets its own translate (the copies may keep it at different levels).
+  struct Candidate {
+    uint32_t i, j;
+    std::array<int, 3> shift;
+    std::vector<Point3> facet;
+  };
+  std::vector<Candidate> candidates;
+  auto deepest = [&](size_t i) { return fine.colours[i]; };
+  const size_t boundary = scan_faces(
+      rules, fine, lattice, cells,
+      [&](size_t i, size_t j, const std::array<int, 3>& shift) {
+        if (deepest(i) != deepest(j)) return true;
+        for (int k = 0; k < n; ++k)
+          if (shift[size_t(k)] != s[j][size_t(k)] - s[i][size_t(k)]) return true;
+        return false;
+      },
+      [&](size_t i, size_t j, const std::array<int, 3>& shift, std::vector<Point3>&& facet) {
+        candidates.push_back({uint32_t(i), uint32_t(j), shift, std::move(facet)});
+      });
+  // Each period's walls: the candidates whose two sides lie in different tiles there.
+  const double period_count = double(hi[0] - lo[0]) * double(hi[1] - lo[1]) * double(hi[2] - lo[2]);
+  if (period_count * double(candidates.size()) > 5e7)
+    throw ResourceLimit("voronoi: " + std::to_string(int64_t(period_count)) + " periods of up to " +
+                        std::to_string(candidates.size()) + " walls each are too many; use a larger period");
+  std::vector<std::array<int, 3>> periods;
+  for (int z2 = lo[2]; z2 < hi[2]; ++z2)
+    for (int z1 = lo[1]; z1 < hi[1]; ++z1)
+      for (int z0 = lo[0]; z0 < hi[0]; ++z0) periods.push_back({z0, z1, z2});
+  std::vector<Walls> per_period(periods.size());
+  const int64_t total_nodes = node_offset.back();
+  tbb::parallel_for(size_t(0), periods.size(), [&](size_t q) {
+    const std::array<int, 3>& z = periods[q];
+    Walls& w = per_period[q];
+    for (const Candidate& c : candidates) {
+      std::array<int, 3> ai{0, 0, 0}, aj{0, 0, 0};
+      for (int k = 0; k < n; ++k) {
+        ai[size_t(k)] = z[size_t(k)] - s[c.i][size_t(k)];
+        aj[size_t(k)] = z[size_t(k)] + c.shift[size_t(k)] - s[c.j][size_t(k)];
+      }
+      const int64_t xi = anchor_index(ai), xj = anchor_index(aj);
+      const int64_t ti = tile_of(xi, c.i), tj = tile_of(xj, c.j);
+      if (ti == tj) continue;  // one tile, or copies of one that meet (as the periodic walls, no wall between them)
+      std::vector<Point3> facet = c.facet;
+      for (Point3& v : facet)
+        for (int k = 0; k < n; ++k) v[size_t(k)] += z[size_t(k)];
+      w.measure += facet_measure(facet, n);
+      w.facets.push_back(std::move(facet));
+      w.colours.push_back({int(xi * total_nodes + ti), int(xj * total_nodes + tj)});
+    }
+  });
+  RefinedWalls out;
+  Walls& walls = out.walls;
+  walls.dimension = n;
+  walls.points = fine.points.size() * periods.size();
+  walls.boundary_generators = boundary * periods.size();
+  std::vector<int> instances;
+  for (Walls& w : per_period) {
+    walls.measure += w.measure;
+    for (size_t f = 0; f < w.facets.size(); ++f) {
+      walls.facets.push_back(std::move(w.facets[f]));
+      walls.colours.push_back(w.colours[f]);
+      instances.push_back(w.colours[f].first);
+      instances.push_back(w.colours[f].second);
+    }
+    w = Walls();
+  }
+  std::sort(instances.begin(), instances.end());
+  instances.erase(std::unique(instances.begin(), instances.end()), instances.end());
+  out.tiles_per_level.assign(size_t(levels) + 1, 0);
+  for (int id : instances) {
+    const int64_t node = int64_t(id) % total_nodes;
+    const size_t l = size_t(std::upper_bound(node_offset.begin(), node_offset.end(), node) - node_offset.begin()) - 1;
+    ++out.tiles_per_level[l];
+  }
+  return out;
 }
 
 Walls walls_by_clipping(const Level& level) {

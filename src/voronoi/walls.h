@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstddef>
+#include <functional>
 #include <utility>
 #include <vector>
 
@@ -38,6 +39,25 @@ Walls extract_walls(const Rules& rules, const Level& level);
 // The same walls from every generator's own clipped cell (periodic_cells): the reference for extract_walls,
 // valid for any level, at the cost of computing every cell.
 Walls walls_by_clipping(const Level& level);
+
+// A refined tiling (refine_level) laid over the periods [lo, hi) of each axis (one period along axes past the
+// dimension) with every copy of a tile refined on its own: the copy anchored at period a of a tile whose
+// generator's unwrapped position is u splits while refine(u + a, l) says so, so a field is read where each
+// tile lies instead of repeating the first period's choices. The walls are the faces of the level
+// detail + levels between points of different tiles (as in refine_level, copies of one tile that meet
+// have none between them); facets in torus units with their periods added (draw them over the single
+// period [0, 1)), colours numbering the tile copies.
+// tiles_per_level counts the copies, per level kept, that have a wall in the periods. With a refine that
+// does not depend on the anchor, every period holds the walls of refine_level's level (tested). Throws
+// InvalidInput for negative levels or an empty box, ResourceLimit when the copies times the tiles exceed
+// 2e8, the periods times the faces between deepest tiles 5e7, or the level the limit of generate_level.
+struct RefinedWalls {
+  Walls walls;
+  std::vector<int> tiles_per_level;
+};
+RefinedWalls refined_walls(const Rules& rules, int detail, int levels, const std::array<int, 3>& lo,
+                           const std::array<int, 3>& hi,
+                           const std::function<bool(const std::vector<double>& x, int l)>& refine);
 
 // The 3D walls repeated over the periods [lo, hi) of each axis, as triangles (a fan per facet) in mm:
 // x_mm = origin_mm + period_mm x. Throws InvalidInput for 2D walls.
