@@ -586,6 +586,7 @@ TEST(Junction, RefusesUAutomataThatCannotMeetAndBadOptions) {
     FAIL() << "a u automaton without equal pieces on a segment was accepted";
   } catch (const InvalidInput& e) {
     EXPECT_NE(std::string(e.what()).find("linear precision"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("side B"), std::string::npos) << e.what();
   }
   // Halves of a Bezier arc do have linear precision: accepted.
   TensorSurface even = s.b;
@@ -594,7 +595,37 @@ TEST(Junction, RefusesUAutomataThatCannotMeetAndBadOptions) {
   TensorSurface cubic = s.b;  // a u automaton on four points: the borders cannot share A's polygon
   cubic.u = nurbs_automaton(3, {0, 1, 2, 3, 4, 5}).automaton;
   cubic.control_points.conservativeResize(3, 12);
-  EXPECT_THROW(junction(s.a, cubic, JunctionOptions{}), InvalidInput);
+  try {
+    junction(s.a, cubic, JunctionOptions{});
+    FAIL() << "a u automaton on four points was joined to one on three";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("control points"), std::string::npos) << e.what();
+  }
+  // Three points that split into two-point pieces (the quadratic Bezier's halves drawn as their chords,
+  // linear precision with the parameter 0, 1/2, 1) meet A's three-point pieces in sizes that differ.
+  TensorSurface chords = s.b;
+  {
+    Automaton a;
+    State three, two;
+    three.name = "three";
+    three.control_points = 3;
+    two.name = "two";
+    two.control_points = 2;
+    a.states = {three, two};
+    Eigen::MatrixXd left(3, 2), right(3, 2), half_left(2, 2), half_right(2, 2);
+    left << 1, 0.25, 0, 0.5, 0, 0.25;
+    right << 0.25, 0, 0.5, 0, 0.25, 1;
+    half_left << 1, 0.5, 0, 0.5;
+    half_right << 0.5, 0, 0.5, 1;
+    a.transitions = {{Transition{0, 1, left}, Transition{1, 1, right}}, {Transition{0, 1, half_left}, Transition{1, 1, half_right}}};
+    chords.u = a;
+  }
+  try {
+    junction(s.a, chords, JunctionOptions{});
+    FAIL() << "u automata whose pieces differ in size were joined";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("differ in size"), std::string::npos) << e.what();
+  }
   JunctionOptions wide;
   wide.ratio = 0.5;
   EXPECT_THROW(junction(s.a, s.b, wide), InvalidInput);
@@ -634,7 +665,7 @@ TEST(Junction, ReadFromJsonWithTheSidesAsSystems) {
     parse_system(system, "r.json", "system");
     FAIL() << "sides whose u automata cannot meet were accepted";
   } catch (const InvalidInput& e) {
-    EXPECT_NE(std::string(e.what()).find("junction"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("symbols"), std::string::npos) << e.what();  // Koch has four pieces
   }
 }
 

@@ -141,11 +141,23 @@ Automaton typed_product(const Automaton& ua, const Automaton& ub, const Automato
     out.states.push_back(s);
     out.transitions.emplace_back();
     const int lead = key[1] >= 0 ? 0 : 1;
+    if (key[1] >= 0 && key[2] >= 0 &&
+        u[0]->transitions[size_t(key[1])].size() != u[1]->transitions[size_t(key[2])].size())
+      throw InvalidInput("the junction's u automata split their pieces differently where they meet (states \"" +
+                         u[0]->states[size_t(key[1])].name + "\" and \"" + u[1]->states[size_t(key[2])].name + "\")");
     for (const Transition& tu : u[lead]->transitions[size_t(key[1 + lead])]) {
       const Transition* tn[2] = {nullptr, nullptr};
       for (int n = 0; n < 2; ++n)
         if (key[1 + n] >= 0) tn[n] = find_transition(*u[n], key[1 + n], tu.symbol);
-      if ((key[1] >= 0 && !tn[0]) || (key[2] >= 0 && !tn[1])) continue;
+      if ((key[1] >= 0 && !tn[0]) || (key[2] >= 0 && !tn[1]))
+        throw InvalidInput("the junction's u automata split their pieces differently where they meet (symbol " +
+                           std::to_string(tu.symbol) + " is defined in one only)");
+      if (tn[0] && tn[1] &&
+          u[0]->states[size_t(tn[0]->target)].control_points != u[1]->states[size_t(tn[1]->target)].control_points)
+        throw InvalidInput("the junction's u automata differ in size where they meet (" +
+                           std::to_string(u[0]->states[size_t(tn[0]->target)].control_points) + " and " +
+                           std::to_string(u[1]->states[size_t(tn[1]->target)].control_points) +
+                           " control points after symbol " + std::to_string(tu.symbol) + ")");
       for (const Transition& tw : w.transitions[size_t(key[0])]) {
         Key target{tw.target, -1, -1};
         Eigen::MatrixXd matrix;

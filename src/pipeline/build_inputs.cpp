@@ -500,17 +500,14 @@ class Builder {
   // `refine` (voronoi_tiles, voronoi_foam): the partition's fractal cells, each replaced by its children while
   // the field at its generator asks for it, every tile drawn with `level` levels of detail; part.level's colours
   // become the tiles. Returns the tiles' starting colours and counts per level. The field is read at each tile's
-  // generator where the tile is drawn: compact tiles (keep_unwrapped) at its unwrapped position, the foam's
-  // periodic walls in the period at the origin.
+  // generator where the compact tile is drawn (its unwrapped position).
   voronoi::RefinedLevel refine(Partition& part, const VoronoiPartition& partition, const GradeField& field,
                                int levels, bool keep_unwrapped) {
     const voronoi::TorusPlacement& place = part.place;
     try {
       voronoi::RefinedLevel refined = voronoi::refine_level(
           part.rules, partition.level, levels,
-          [&](const std::vector<double>& u, int l) {
-            double x[3] = {0, 0, 0};
-            for (size_t j = 0; j < u.size() && j < 3; ++j) x[j] = keep_unwrapped ? u[j] : u[j] - std::floor(u[j]);
+          [&](const std::vector<double>& x, int l) {
             const Vec3d p = place.to_mm(x[0], x[1], place.dimension == 3 ? x[2] : 0.0);
             return field.at(p) > double(l + 1) / double(levels + 1);
           },
@@ -563,6 +560,9 @@ class Builder {
       const Box3 box = box_of(*v.cover);
       const Vec3d lo = (box.min - place.origin_mm) / place.period_mm;
       const Vec3d hi = (box.max - place.origin_mm) / place.period_mm;
+      for (int k = 0; k < 3; ++k)
+        if (!(std::fabs(lo[k]) < 1e6 && std::fabs(hi[k]) < 1e6))
+          throw ResourceLimit(where() + ".cover: its box spans more than a million periods; use a larger period_mm");
       a = {int(std::floor(lo.x)) - 1, int(std::floor(lo.y)) - 1, int(std::floor(lo.z)) - 1};
       b = {int(std::ceil(hi.x)) + 1, int(std::ceil(hi.y)) + 1, int(std::ceil(hi.z)) + 1};
     }

@@ -161,13 +161,17 @@ Walls extract_walls(const Rules& rules, const Level& level) {
 RefinedWalls refined_walls(const Rules& rules, int detail, int levels, const std::array<int, 3>& lo,
                            const std::array<int, 3>& hi,
                            const std::function<bool(const std::vector<double>& x, int l)>& refine) {
-  if (detail < 0 || levels < 0)
-    throw InvalidInput("voronoi: a refined level needs detail >= 0 and levels >= 0, got " + std::to_string(detail) +
+  if (detail < 0 || levels < 0 || levels > 7)
+    throw InvalidInput("voronoi: a refined level needs detail >= 0 and 0 to 7 levels, got " + std::to_string(detail) +
                        " and " + std::to_string(levels));
   const int n = rules.dimension;
-  for (int k = 0; k < 3; ++k)
+  double period_count = 1;
+  for (int k = 0; k < 3; ++k) {
     if (hi[size_t(k)] <= lo[size_t(k)] || (k >= n && hi[size_t(k)] - lo[size_t(k)] != 1))
       throw InvalidInput("voronoi: the periods to refine over must be a non-empty box (one period along unused axes)");
+    period_count *= double(hi[size_t(k)]) - double(lo[size_t(k)]);
+  }
+  if (period_count > 1e7) throw ResourceLimit("voronoi: more than 10 000 000 periods to refine over; use a larger period");
   // The fine level with each point's deepest tile (its node of level `levels`, the recursion's order) as
   // its colour.
   const Level fine = refine_level(rules, detail, levels, [](const std::vector<double>&, int) { return true; }, true).level;
@@ -175,54 +179,68 @@ RefinedWalls refined_walls(const Rules& rules, int detail, int levels, const std
   const std::vector<Cell> cells = shape_cells(rules);
   // Whole periods from each generator's wrapped position to its unwrapped one (where its tile lies).
   std::vector<std::array<int, 3>> s(fine.points.size(), {0, 0, 0});
-  std::array<int, 3> smin{0, 0, 0}, smax{0, 0, 0};
   for (size_t i = 0; i < fine.points.size(); ++i)
-    for (int k = 0; k < n; ++k) {
+    for (int k = 0; k < n; ++k)
       s[i][size_t(k)] = int(std::lround(fine.unwrapped[i][size_t(k)] - fine.points[i][size_t(k)]));
-      smin[size_t(k)] = std::min(smin[size_t(k)], s[i][size_t(k)]);
-      smax[size_t(k)] = std::max(smax[size_t(k)], s[i][size_t(k)]);
-    }
+  // Faces that can be walls in some copy: between points of different deepest tiles, or of copies of one
+  // that meets its own translate (the copies may keep it at different levels). Counted first, so that
+  // nothing grows past the bound; a side's anchor is its period plus its reach (-s_i, shift - s_j).
+  auto wanted = [&](size_t i, size_t j, const std::array<int, 3>& shift) {
+    if (fine.colours[i] != fine.colours[j]) return true;
+    for (int k = 0; k < n; ++k)
+      if (shift[size_t(k)] != s[j][size_t(k)] - s[i][size_t(k)]) return true;
+    return false;
+  };
+  size_t candidate_count = 0;
+  std::array<int, 3> reach_min{0, 0, 0}, reach_max{0, 0, 0};
+  const size_t boundary = scan_faces(rules, fine, lattice, cells, wanted,
+                                     [&](size_t i, size_t j, const std::array<int, 3>& shift, std::vector<Point3>&&) {
+                                       ++candidate_count;
+                                       for (int k = 0; k < n; ++k) {
+                                         const int ri = -s[i][size_t(k)], rj = shift[size_t(k)] - s[j][size_t(k)];
+                                         reach_min[size_t(k)] = std::min({reach_min[size_t(k)], ri, rj});
+                                         reach_max[size_t(k)] = std::max({reach_max[size_t(k)], ri, rj});
+                                       }
+                                     });
+  if (period_count * double(candidate_count) > 5e7)
+    throw ResourceLimit("voronoi: " + std::to_string(int64_t(period_count)) + " periods of up to " +
+                        std::to_string(candidate_count) + " walls each are too many; use a larger period");
+  // Every copy of the tiling that a side of a face in the periods lies in: anchors lo + reach_min .. hi - 1 +
+  // reach_max. The nodes asked (levels < levels) number m (d^n)^l at level l.
+  std::array<int, 3> amin{0, 0, 0}, acount{1, 1, 1};
+  double anchors_d = 1;
+  for (int k = 0; k < n; ++k) {
+    amin[size_t(k)] = lo[size_t(k)] + reach_min[size_t(k)];
+    acount[size_t(k)] = (hi[size_t(k)] - 1 + reach_max[size_t(k)]) - amin[size_t(k)] + 1;
+    anchors_d *= double(acount[size_t(k)]);
+  }
+  double per_level = double(rules.points.size()), asked_d = 0;
+  for (int l = 0; l < levels; ++l) {
+    asked_d += per_level;
+    per_level *= std::pow(double(rules.d), n);
+  }
+  if (anchors_d * std::max(asked_d, 1.0) > 2e8 || anchors_d * (asked_d + per_level) > 2e9)
+    throw ResourceLimit("voronoi: refining " + std::to_string(int64_t(anchors_d)) + " copies of " +
+                        std::to_string(int64_t(asked_d)) + " tiles each is too much; use a larger period or fewer "
+                        "refinement levels");
+  const int64_t anchors = int64_t(anchors_d);
   // The recursion's nodes of levels 0 .. levels (the tiles a point can end in), in its order (global ids
-  // node_offset[l] + j), and every deepest node's ancestors: a node's children follow it in the next
-  // level, as many as its shape's rules.
+  // node_offset[l] + j), and each node's parent: a node's children follow it in the next level, as many as
+  // its shape's rules.
   std::vector<Level> nodes;
   std::vector<int64_t> node_offset{0};
   for (int l = 0; l <= levels; ++l) {
     nodes.push_back(generate_level(rules, l, true));
     node_offset.push_back(node_offset.back() + int64_t(nodes.back().points.size()));
   }
-  const size_t deepest_count = nodes.back().points.size();
-  std::vector<std::vector<int64_t>> ancestor(size_t(levels) + 1, std::vector<int64_t>(deepest_count));
-  {
-    std::vector<int64_t> parent_of_next;  // per node of level l + 1: its parent in level l
-    std::vector<std::vector<int64_t>> parent(size_t(levels) + 1);
-    for (int l = 0; l < levels; ++l) {
-      auto& next = parent[size_t(l) + 1];
-      for (size_t j = 0; j < nodes[size_t(l)].points.size(); ++j)
-        for (size_t c = 0; c < rules.rules[size_t(nodes[size_t(l)].shapes[j])].size(); ++c) next.push_back(int64_t(j));
-      if (next.size() != nodes[size_t(l) + 1].points.size()) throw std::logic_error("voronoi: the levels' sizes disagree");
-    }
-    for (size_t k = 0; k < deepest_count; ++k) {
-      int64_t j = int64_t(k);
-      for (int l = levels; l >= 0; --l) {
-        ancestor[size_t(l)][k] = j;
-        if (l > 0) j = parent[size_t(l)][size_t(j)];
-      }
-    }
+  std::vector<std::vector<int32_t>> parent(size_t(levels) + 1);
+  for (int l = 0; l < levels; ++l) {
+    auto& next = parent[size_t(l) + 1];
+    for (size_t j = 0; j < nodes[size_t(l)].points.size(); ++j)
+      for (size_t c = 0; c < rules.rules[size_t(nodes[size_t(l)].shapes[j])].size(); ++c) next.push_back(int32_t(j));
+    if (next.size() != nodes[size_t(l) + 1].points.size()) throw std::logic_error("voronoi: the levels' sizes disagree");
   }
-  const int64_t split_nodes = node_offset[size_t(levels)];  // nodes of levels < levels: the ones asked
-  // Every copy of the tiling that reaches the periods: anchors a with a + s + (a neighbour's shift) inside.
-  std::array<int, 3> amin{0, 0, 0}, acount{1, 1, 1};
-  int64_t anchors = 1;
-  for (int k = 0; k < n; ++k) {
-    amin[size_t(k)] = lo[size_t(k)] - smax[size_t(k)] - 1;
-    acount[size_t(k)] = (hi[size_t(k)] - smin[size_t(k)] + 1) - amin[size_t(k)];
-    anchors *= acount[size_t(k)];
-  }
-  if (double(anchors) * double(std::max<int64_t>(split_nodes, 1)) > 2e8 ||
-      double(anchors) * double(node_offset.back()) > 2e9)
-    throw ResourceLimit("voronoi: refining " + std::to_string(anchors) + " copies of " + std::to_string(split_nodes) +
-                        " tiles each is too much; use a larger period or fewer refinement levels");
+  const int64_t split_nodes = node_offset[size_t(levels)], total_nodes = node_offset.back();
   auto anchor_index = [&](const std::array<int, 3>& a) {
     int64_t index = 0;
     for (int k = n - 1; k >= 0; --k) index = index * acount[size_t(k)] + (a[size_t(k)] - amin[size_t(k)]);
@@ -244,45 +262,37 @@ RefinedWalls refined_walls(const Rules& rules, int detail, int levels, const std
         split[size_t(index * split_nodes + node_offset[size_t(l)] + int64_t(j))] = refine(x, l) ? 1 : 0;
       }
   });
-  // The tile (global node id) point i ends in, in the copy at anchor index ai.
+  // The tile (global node id) point i ends in, in the copy at anchor index ai: its deepest node's ancestors
+  // from the top while they split.
   auto tile_of = [&](int64_t ai, size_t i) {
-    const size_t k = size_t(fine.colours[i]);
-    for (int l = 0;; ++l) {
-      const int64_t j = ancestor[size_t(l)][k];
-      if (l == levels || !split[size_t(ai * split_nodes + node_offset[size_t(l)] + j)]) return node_offset[size_t(l)] + j;
+    std::array<int64_t, 8> chain{};
+    int64_t j = fine.colours[i];
+    for (int l = levels; l >= 0; --l) {
+      chain[size_t(l)] = j;
+      if (l > 0) j = parent[size_t(l)][size_t(j)];
     }
+    for (int l = 0;; ++l)
+      if (l == levels || !split[size_t(ai * split_nodes + node_offset[size_t(l)] + chain[size_t(l)])])
+        return node_offset[size_t(l)] + chain[size_t(l)];
   };
-  // Faces that can be walls in some copy: between points of different deepest tiles, or of copies of one
-  // that meets its own translate (the copies may keep it at different levels).
   struct Candidate {
     uint32_t i, j;
     std::array<int, 3> shift;
     std::vector<Point3> facet;
   };
   std::vector<Candidate> candidates;
-  auto deepest = [&](size_t i) { return fine.colours[i]; };
-  const size_t boundary = scan_faces(
-      rules, fine, lattice, cells,
-      [&](size_t i, size_t j, const std::array<int, 3>& shift) {
-        if (deepest(i) != deepest(j)) return true;
-        for (int k = 0; k < n; ++k)
-          if (shift[size_t(k)] != s[j][size_t(k)] - s[i][size_t(k)]) return true;
-        return false;
-      },
-      [&](size_t i, size_t j, const std::array<int, 3>& shift, std::vector<Point3>&& facet) {
-        candidates.push_back({uint32_t(i), uint32_t(j), shift, std::move(facet)});
-      });
-  // Each period's walls: the candidates whose two sides lie in different tiles there.
-  const double period_count = double(hi[0] - lo[0]) * double(hi[1] - lo[1]) * double(hi[2] - lo[2]);
-  if (period_count * double(candidates.size()) > 5e7)
-    throw ResourceLimit("voronoi: " + std::to_string(int64_t(period_count)) + " periods of up to " +
-                        std::to_string(candidates.size()) + " walls each are too many; use a larger period");
+  candidates.reserve(candidate_count);
+  scan_faces(rules, fine, lattice, cells, wanted,
+             [&](size_t i, size_t j, const std::array<int, 3>& shift, std::vector<Point3>&& facet) {
+               candidates.push_back({uint32_t(i), uint32_t(j), shift, std::move(facet)});
+             });
+  // Each period's walls: the candidates whose two sides end in different tiles there (copies of one tile
+  // that meet have no wall between them, as in the periodic walls).
   std::vector<std::array<int, 3>> periods;
   for (int z2 = lo[2]; z2 < hi[2]; ++z2)
     for (int z1 = lo[1]; z1 < hi[1]; ++z1)
       for (int z0 = lo[0]; z0 < hi[0]; ++z0) periods.push_back({z0, z1, z2});
   std::vector<Walls> per_period(periods.size());
-  const int64_t total_nodes = node_offset.back();
   tbb::parallel_for(size_t(0), periods.size(), [&](size_t q) {
     const std::array<int, 3>& z = periods[q];
     Walls& w = per_period[q];
@@ -294,7 +304,7 @@ RefinedWalls refined_walls(const Rules& rules, int detail, int levels, const std
       }
       const int64_t xi = anchor_index(ai), xj = anchor_index(aj);
       const int64_t ti = tile_of(xi, c.i), tj = tile_of(xj, c.j);
-      if (ti == tj) continue;  // one tile, or copies of one that meet (as the periodic walls, no wall between them)
+      if (ti == tj) continue;
       std::vector<Point3> facet = c.facet;
       for (Point3& v : facet)
         for (int k = 0; k < n; ++k) v[size_t(k)] += z[size_t(k)];
@@ -306,8 +316,8 @@ RefinedWalls refined_walls(const Rules& rules, int detail, int levels, const std
   RefinedWalls out;
   Walls& walls = out.walls;
   walls.dimension = n;
-  walls.points = fine.points.size() * periods.size();
-  walls.boundary_generators = boundary * periods.size();
+  walls.points = fine.points.size();  // per period, as extract_walls
+  walls.boundary_generators = boundary;
   std::vector<int> instances;
   for (Walls& w : per_period) {
     walls.measure += w.measure;

@@ -48,9 +48,11 @@ Walls walls_by_clipping(const Level& level);
 // have none between them); facets in torus units with their periods added (draw them over the single
 // period [0, 1)), colours numbering the tile copies.
 // tiles_per_level counts the copies, per level kept, that have a wall in the periods. With a refine that
-// does not depend on the anchor, every period holds the walls of refine_level's level (tested). Throws
-// InvalidInput for negative levels or an empty box, ResourceLimit when the copies times the tiles exceed
-// 2e8, the periods times the faces between deepest tiles 5e7, or the level the limit of generate_level.
+// does not depend on the anchor, every period holds the walls of refine_level's level (tested); `points` and
+// `boundary_generators` are per period, `facets` and `measure` those of all periods. Throws
+// InvalidInput for negative levels, more than 7 or an empty box; ResourceLimit (before allocating them) when
+// the periods exceed 1e7, the periods times the faces between deepest tiles 5e7, the copies times the tiles
+// asked 2e8 (times all tiles 2e9), or the level the limit of generate_level.
 struct RefinedWalls {
   Walls walls;
   std::vector<int> tiles_per_level;
