@@ -216,6 +216,22 @@ def test_bcifs_volume_opens_a_cube_into_a_handlebody():
     assert opened.volume_mm3 < sealed.volume_mm3
 
 
+def test_cifs_support_stands_the_shell_on_the_plate():
+    # A bi-quadratic roof between z = 10 and 16 on its level-2 tree rooted on the plate: one solid reaching
+    # z = 0, the same solid as the cifs shell with its "support" key.
+    roof = {"nurbs_surface": {"u": {"degree": 2, "knots": [0, 1, 3, 4]}, "v": {"degree": 2, "knots": [0, 1, 2, 3]}},
+            "control_points_mm": [[[0, 0, 10], [0, 8, 10], [0, 16, 10]], [[10, 0, 11], [10, 8, 16], [10, 16, 11]],
+                                  [[20, 0, 12], [20, 8, 12], [20, 16, 12]]]}
+    tree = lacuna.cifs_support(system=roof, level=2, thickness_mm=0.8, base_mm=[10, 8, 0], base_size_mm=3)
+    m = tree.mesh(voxel_size_mm=0.2)
+    same = lacuna.cifs(system=roof, level=2, thickness_mm=0.8, support={"base_mm": [10, 8, 0], "base_size_mm": 3})
+    alone = lacuna.cifs(system=roof, level=2, thickness_mm=0.8).mesh(voxel_size_mm=0.2)
+    assert m.components == 1
+    assert abs(m.vertices[:, 2].min()) < 0.2 and alone.vertices[:, 2].min() > 9
+    near(m.volume_mm3, same.mesh(voxel_size_mm=0.2).volume_mm3, 1e-12)
+    assert m.volume_mm3 > alone.volume_mm3
+
+
 def test_union_difference_intersection_of_spheres():
     a = lacuna.sphere(radius_mm=3)
     b = lacuna.sphere(center_mm=[3.5, 0.4, 0], radius_mm=2)

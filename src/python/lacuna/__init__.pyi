@@ -287,7 +287,19 @@ def cifs(
     fit_to: Solid = ...,
     **keys: Any,
 ) -> Solid:
-    """Also takes `as` (tubes, shell, cells, edges): cifs(system=..., **{"as": "edges"})."""
+    """Also takes `as` (tubes, shell, cells, edges): cifs(system=..., **{"as": "edges"}), and support."""
+def cifs_support(
+    *,
+    system: Union[str, Mapping[str, Any]],
+    base_mm: Sequence[float],
+    level: int = ...,
+    thickness_mm: float = ...,
+    fit_to: Solid = ...,
+    base_size_mm: float = ...,
+    fork: float = ...,
+    shrink: float = ...,
+) -> Solid:
+    """A cifs shell (a tensor surface) stood on its own fractal tree, rooted at base_mm on the plate."""
 def curve(
     *,
     kind: Literal["hilbert", "sierpinski", "hilbert3d"] = ...,
