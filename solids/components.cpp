@@ -3,6 +3,30 @@
 #include "solids/mesh_topology.h"
 
 namespace lacuna {
+namespace {
+
+// The mesh without the triangles flagged in `drop` and the vertices left unused (the others keep their
+// order).
+void drop_triangles(TriMesh& mesh, const std::vector<uint8_t>& drop) {
+  std::vector<uint32_t> index(mesh.positions_mm.size(), UINT32_MAX);
+  TriMesh kept;
+  for (size_t f = 0; f < mesh.triangles.size(); ++f) {
+    if (drop[f]) continue;
+    std::array<uint32_t, 3> out{};
+    for (int k = 0; k < 3; ++k) {
+      uint32_t& i = index[mesh.triangles[f][size_t(k)]];
+      if (i == UINT32_MAX) {
+        i = uint32_t(kept.positions_mm.size());
+        kept.positions_mm.push_back(mesh.positions_mm[mesh.triangles[f][size_t(k)]]);
+      }
+      out[size_t(k)] = i;
+    }
+    kept.triangles.push_back(out);
+  }
+  mesh = std::move(kept);
+}
+
+}  // namespace
 
 std::vector<MeshComponent> mesh_components(const TriMesh& m) {
   const VertexComponents components = vertex_components(m);
@@ -64,23 +88,33 @@ SmallShells remove_small_shells(TriMesh& mesh, double max_volume_mm3) {
     }
   }
   if (removed.cavities + removed.specks == 0) return removed;
-  std::vector<uint32_t> index(mesh.positions_mm.size(), UINT32_MAX);
-  TriMesh kept;
-  for (const auto& t : mesh.triangles) {
-    if (drop[components.of_vertex[t[0]]]) continue;
-    std::array<uint32_t, 3> out{};
-    for (int k = 0; k < 3; ++k) {
-      uint32_t& i = index[t[size_t(k)]];
-      if (i == UINT32_MAX) {
-        i = uint32_t(kept.positions_mm.size());
-        kept.positions_mm.push_back(mesh.positions_mm[t[size_t(k)]]);
-      }
-      out[size_t(k)] = i;
-    }
-    kept.triangles.push_back(out);
-  }
-  mesh = std::move(kept);
+  std::vector<uint8_t> drop_triangle(mesh.triangles.size(), 0);
+  for (size_t f = 0; f < mesh.triangles.size(); ++f) drop_triangle[f] = drop[components.of_vertex[mesh.triangles[f][0]]];
+  drop_triangles(mesh, drop_triangle);
   return removed;
+}
+
+std::vector<MeshComponent> loose_pieces(const TriMesh& mesh, double max_volume_mm3) {
+  std::vector<MeshComponent> all = mesh_components(mesh), out;
+  auto inside = [](const Box3& inner, const Box3& outer) {
+    return inner.min.x >= outer.min.x && inner.min.y >= outer.min.y && inner.min.z >= outer.min.z &&
+           inner.max.x <= outer.max.x && inner.max.y <= outer.max.y && inner.max.z <= outer.max.z;
+  };
+  for (size_t c = 0; c < all.size(); ++c) {
+    if (!(all[c].signed_volume_mm3 > 0 && all[c].signed_volume_mm3 < max_volume_mm3)) continue;
+    bool holds = false;
+    for (size_t o = 0; o < all.size() && !holds; ++o) holds = o != c && inside(all[o].box, all[c].box);
+    if (!holds) out.push_back(std::move(all[c]));
+  }
+  return out;
+}
+
+void remove_components(TriMesh& mesh, const std::vector<MeshComponent>& components) {
+  if (components.empty()) return;
+  std::vector<uint8_t> drop(mesh.triangles.size(), 0);
+  for (const MeshComponent& c : components)
+    for (uint32_t t : c.triangles) drop[t] = 1;
+  drop_triangles(mesh, drop);
 }
 
 }  // namespace lacuna

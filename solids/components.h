@@ -32,4 +32,13 @@ struct SmallShells {
 // wall's corner clipped by a hull): unprintable dust, not part of the design.
 SmallShells remove_small_shells(TriMesh& mesh, double max_volume_mm3);
 
+// The separate bodies of a closed mesh enclosing less than `max_volume_mm3`: outward shells (positive
+// volume) whose bounding box holds no other shell's box, so that nothing is nested in them (a body
+// with a cavity, or one inside another's cavity's box, is never one). In order of their first triangle.
+std::vector<MeshComponent> loose_pieces(const TriMesh& mesh, double max_volume_mm3);
+
+// The mesh without the given components' triangles and the vertices left unused (the others keep
+// their order).
+void remove_components(TriMesh& mesh, const std::vector<MeshComponent>& components);
+
 }  // namespace lacuna

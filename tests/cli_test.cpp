@@ -1041,6 +1041,54 @@ TEST(Cli, VoronoiFoamRefinedOverPeriodsWhereEachTileLies) {
   EXPECT_GT(cover[2], 3 * cover[1]);
 }
 
+TEST(Cli, PrintabilityFindsAndRemovesLoosePieces) {
+  // A 3 mm ball with a 0.35 mm bead beside it (not touching) and a hollow 0.45 mm bead (a sealed 0.25 mm
+  // cavity) far off, min_piece_mm3 0.5. "report": the bead is a loose piece (0.180 mm3); the hollow bead's
+  // outer shell encloses less (0.38 mm3) but holds a cavity, so it is none (removing that shell alone would
+  // leave the cavity's inside out). "fix" drills the cavity open (a 0.1 mm drain hole), which leaves the hollow
+  // bead a small open cup, a loose piece too: both go. "error" fails the output and writes nothing.
+  TempDir dir;
+  auto run = [&](const std::string& name, const std::string& on_failure) {
+    write_file(dir / (name + ".json"), R"({"voxel_size_mm": 0.05, "inputs": {
+        "ball": {"type": "sphere", "radius_mm": 3}, "bead": {"type": "sphere", "center_mm": [4, 0, 0], "radius_mm": 0.35},
+        "outer": {"type": "sphere", "center_mm": [-6, 0, 0], "radius_mm": 0.45},
+        "inner": {"type": "sphere", "center_mm": [-6, 0, 0], "radius_mm": 0.25}},
+        "operations": [{"name": "hollow", "op": "difference", "of": ["outer", "inner"]},
+                       {"name": "part", "op": "union", "of": ["ball", "bead", "hollow"]}],
+        "printability": {"min_piece_mm3": 0.5, "drain_hole_mm": 0.1, "on_failure": ")" + on_failure + R"("},
+        "outputs": [{"of": "part", "file": "part.stl"}]})");
+    return lacuna("run " + quote((dir / (name + ".json")).string()) + " -o " + quote((dir / name).string()) + " --json",
+                  dir.path());
+  };
+  const double bead = 4.0 / 3 * M_PI * 0.35 * 0.35 * 0.35, ball = 4.0 / 3 * M_PI * 27;
+  const double hollow = 4.0 / 3 * M_PI * (0.45 * 0.45 * 0.45 - 0.25 * 0.25 * 0.25);
+  Result listed = run("report", "report");
+  ASSERT_EQ(listed.code, 0) << listed.err;
+  const nlohmann::json r = nlohmann::json::parse(listed.out)["outputs"][0];
+  EXPECT_EQ(r["components"], 4);  // ball, bead, the hollow bead's two shells
+  EXPECT_EQ(r["printability"]["trapped_voids"].size(), 1u);
+  ASSERT_EQ(r["printability"]["loose_pieces"].size(), 1u);
+  EXPECT_NEAR(r["printability"]["loose_pieces"][0]["volume_mm3"].get<double>(), bead, 0.05 * bead);
+  EXPECT_NEAR(r["printability"]["loose_pieces"][0]["location"][0].get<double>(), 4.0, 0.01);
+  EXPECT_EQ(r["printability"]["loose_pieces_removed"], 0);
+  Result fixed = run("fix", "fix");
+  ASSERT_EQ(fixed.code, 0) << fixed.err;
+  const nlohmann::json f = nlohmann::json::parse(fixed.out)["outputs"][0];
+  EXPECT_EQ(f["components"], 1);
+  EXPECT_EQ(f["printability"]["drain_holes"], 1);
+  EXPECT_EQ(f["printability"]["loose_pieces_removed"], 2);
+  EXPECT_TRUE(f["printability"]["loose_pieces"].empty());
+  const double removed = f["printability"]["loose_volume_removed_mm3"].get<double>();
+  EXPECT_GT(removed, bead);
+  EXPECT_LT(removed, bead + hollow * 1.05);
+  EXPECT_NEAR(f["volume_mm3"].get<double>(), ball, 0.002 * ball);
+  EXPECT_TRUE(f["checks"]["valid"].get<bool>());
+  Result failed = run("error", "error");
+  EXPECT_EQ(failed.code, 4) << failed.err;
+  EXPECT_NE((failed.out + failed.err).find("loose pieces"), std::string::npos) << failed.out << failed.err;
+  EXPECT_FALSE(fs::exists(dir / "error" / "part.stl"));
+}
+
 TEST(Cli, BcifsRulesPlateAndMeasure) {
   TempDir dir;
   Result f0 = lacuna("bcifs rules --boundary " + quote("C2 B2 C2 B2 C2 B2") + " --params " + quote("C2 B2 B2") + " --json",

@@ -29,7 +29,10 @@ nlohmann::json printability_json(const PrintabilityFindings& p) {
           {"overhang_area_mm2", p.overhang_area_mm2},
           {"down_facing_area_mm2", p.down_facing_area_mm2},
           {"drain_holes", p.drain_holes},
-          {"thickened_walls", p.thickened_walls}};
+          {"thickened_walls", p.thickened_walls},
+          {"loose_pieces", features_json(p.loose_pieces)},
+          {"loose_pieces_removed", p.loose_pieces_removed},
+          {"loose_volume_removed_mm3", p.loose_volume_removed_mm3}};
 }
 
 // The object's printability findings and relative density, added to an output's entry.

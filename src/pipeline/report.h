@@ -117,6 +117,9 @@ struct PrintabilityFindings {
   double down_facing_area_mm2 = 0;
   size_t drain_holes = 0;             // drilled by "fix"
   size_t thickened_walls = 0;         // grown by "fix"
+  std::vector<PrintFeature> loose_pieces;  // separate bodies below min_piece_mm3 (kept: "error", "report")
+  size_t loose_pieces_removed = 0;         // by "fix"
+  double loose_volume_removed_mm3 = 0;
   std::vector<std::string> problems;  // what fails the output (none with "report")
 };
 

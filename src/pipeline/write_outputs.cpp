@@ -266,6 +266,34 @@ RunReport write_outputs(const Recipe& recipe, const Plan& plan, Evaluation&& eva
           throw InvalidInput(recipe.file + ": \"" + object + "\" is empty: nothing is left to export");
       }
       volume = Volume();
+      // Loose pieces: separate bodies below the recipe's size, found on the first surface (the others
+      // differ only by their deviation) and, with "fix", removed from every one.
+      if (printability && recipe.printability.min_piece_mm3 > 0 && !surfaces.empty()) {
+        timer.start("printability");
+        const PrintabilitySettings& settings = recipe.printability;
+        const bool fix = settings.on_failure == PrintabilitySettings::OnFailure::kFix;
+        bool first = true;
+        for (auto& [deviation, surface] : surfaces) {
+          const std::vector<MeshComponent> loose = loose_pieces(surface.mesh, settings.min_piece_mm3);
+          if (first) {
+            for (const MeshComponent& c : loose) {
+              if (fix) {
+                ++printability->loose_pieces_removed;
+                printability->loose_volume_removed_mm3 += c.signed_volume_mm3;
+              } else {
+                printability->loose_pieces.push_back({c.signed_volume_mm3, c.centroid_mm, c.box});
+              }
+            }
+            if (!fix && !loose.empty() && settings.on_failure == PrintabilitySettings::OnFailure::kError)
+              printability->problems.push_back(std::to_string(loose.size()) + " loose pieces smaller than " +
+                                               detail::fixed(settings.min_piece_mm3, 4) +
+                                               " mm3 (separate bodies: debris in the powder or resin)");
+            first = false;
+          }
+          if (fix) remove_components(surface.mesh, loose);
+        }
+        timer.start("mesh");
+      }
       if (options.write_report && meshed) {
         timer.start("report");
         add_page_mesh(page, recipe, object, surfaces.begin()->second.mesh, printability, vopt.voxel_size_mm);

@@ -504,7 +504,7 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
   if (top.has("printability")) {
     JsonObject pr = top.object("printability");
     pr.allow_only({"min_wall_mm", "min_hole_mm", "build_direction", "critical_angle_deg", "on_failure", "drain_hole_mm",
-                   "drain"});
+                   "drain", "min_piece_mm3"});
     PrintabilitySettings& p = recipe.printability;
     p.enabled = true;
     p.min_wall_mm = pr.positive_length_or("min_wall_mm", 0.0);
@@ -521,6 +521,9 @@ Recipe parse_recipe(const std::string& text, const std::string& path) {
     std::string drain = pr.string_or("drain", "nearest");
     if (drain != "nearest" && drain != "down") pr.fail("drain", "expected \"nearest\" or \"down\"");
     p.drain_down = drain == "down";
+    p.min_piece_mm3 = pr.number_or("min_piece_mm3", 0.0);
+    if (!(p.min_piece_mm3 >= 0) || !std::isfinite(p.min_piece_mm3))
+      pr.fail("min_piece_mm3", "expected a volume >= 0 (mm^3; 0: loose pieces are not checked)");
   }
   return recipe;
 }

@@ -71,6 +71,9 @@ struct PrintabilitySettings {
   enum class OnFailure { kError, kFix, kReport } on_failure = OnFailure::kError;
   double drain_hole_mm = 2.0;      // fix: diameter of the holes drilled from trapped voids
   bool drain_down = false;         // fix: drill along -build_direction instead of the shortest way
+  // Meshed outputs: separate bodies enclosing less than this (mm^3) are loose pieces, debris in the powder
+  // or resin; "fix" removes them (0: not checked).
+  double min_piece_mm3 = 0;
 };
 
 // Settings of a tetrahedral (FEA) output.
