@@ -380,32 +380,36 @@ std::map<std::vector<int>, std::pair<Eigen::Vector3d, Eigen::Vector3d>> border_p
 
 Cifs side_system(const TensorSurface& s) { return Cifs{"side", tensor_product(s.u, s.v), s.control_points, false}; }
 
-TEST(Junction, BorderPiecesCoincideWithTheSidesAtEveryLevel) {
-  const JunctionSides s = junction_sides();
-  Cifs j = junction(s.a, s.b, JunctionOptions{});
-  complete_primitives(j.automaton);
-  Cifs a = side_system(s.a), b = side_system(s.b);
-  complete_primitives(a.automaton);
-  complete_primitives(b.automaton);
-  // Six transformations: two along u, three across (to A's nature, to the junction, to B's).
+// J's six transformations (two along u, three across: to A's nature, to the junction, to B's), and at levels
+// 1-6 its v = 0 border pieces (first to A's nature, then A's first symbol) against A's at v = 1 (A's last
+// symbol) and its v = 1 pieces against B's at v = 0: the same 2^L words, every corner within 1e-12. `apart`
+// (when given) gets per level the largest distance between the first corners of J's two borders.
+void expect_borders_on_the_sides(Cifs j, Cifs a, Cifs b, std::vector<double>* apart = nullptr) {
+  for (Cifs* c : {&j, &a, &b}) complete_primitives(c->automaton);
   ASSERT_EQ(j.automaton.transitions[size_t(j.automaton.initial)].size(), 6u);
   const int wj = j.automaton.alphabet_size / 2, wa = a.automaton.alphabet_size / 2, wb = b.automaton.alphabet_size / 2;
   ASSERT_EQ(wj, 3);
   for (int level = 1; level <= 6; ++level) {
-    // J at v = 0 (first to A's nature, then A's first symbol) against A at v = 1 (A's last symbol).
     const auto j0 = border_pieces(j, level, wj, 0, 0, 0), a1 = border_pieces(a, level, wa, wa - 1, wa - 1, 1);
     const auto j1 = border_pieces(j, level, wj, 2, wb - 1, 1), b0 = border_pieces(b, level, wb, 0, 0, 0);
     ASSERT_EQ(j0.size(), size_t(1) << level);
     ASSERT_EQ(a1.size(), j0.size());
     ASSERT_EQ(j1.size(), j0.size());
     ASSERT_EQ(b0.size(), j0.size());
-    double worst = 0;
+    double worst = 0, far = 0;
     for (const auto& [word, corners] : j0) {
       worst = std::max({worst, (corners.first - a1.at(word).first).norm(), (corners.second - a1.at(word).second).norm()});
       worst = std::max({worst, (j1.at(word).first - b0.at(word).first).norm(), (j1.at(word).second - b0.at(word).second).norm()});
+      far = std::max(far, (corners.first - j1.at(word).first).norm());
     }
     EXPECT_LT(worst, 1e-12) << "level " << level;
+    if (apart) apart->push_back(far);
   }
+}
+
+TEST(Junction, BorderPiecesCoincideWithTheSidesAtEveryLevel) {
+  const JunctionSides s = junction_sides();
+  expect_borders_on_the_sides(junction(s.a, s.b, JunctionOptions{}), side_system(s.a), side_system(s.b));
 }
 
 // The welded mesh of a surface: vertices, edges, faces and boundary edges.
@@ -425,26 +429,29 @@ MeshCounts counts(const TriMesh& m) {
   return c;
 }
 
+// At levels 1-5: the assembly `all` (junction with sides) is A, J and B each at level L, and welded the
+// three are one disc: no seam between them (a seam would leave boundary edges inside and raise the Euler
+// characteristic above 1) and no overlap; J alone is one too. The outline is the four borders, 2^L edges
+// along u each, and the pieces across v on the two sides.
+void expect_one_disc(const Cifs& all, const Cifs& a, const Cifs& b, const Cifs& j) {
+  for (int level = 1; level <= 5; ++level) {
+    EXPECT_EQ(count_pieces(all.automaton, level),
+              count_pieces(a.automaton, level) + count_pieces(j.automaton, level) + count_pieces(b.automaton, level));
+    const MeshCounts c = counts(tessellate_surface(all, level));
+    EXPECT_EQ(c.vertices - c.edges + c.faces, 1) << "level " << level;
+    const MeshCounts cj = counts(tessellate_surface(j, level));
+    EXPECT_EQ(cj.vertices - cj.edges + cj.faces, 1) << "level " << level;
+    EXPECT_EQ(c.boundary, 2 * (1L << level) + 2 * long(count_pieces(all.automaton, level) >> level)) << "level " << level;
+  }
+}
+
 TEST(Junction, JunctionAndSidesAreOneDiscAndTheMiddleShrinksToTheMidpoint) {
   const JunctionSides s = junction_sides();
   JunctionOptions options;
   options.sides = true;
   Cifs all = junction(s.a, s.b, options);
   Cifs a = side_system(s.a), b = side_system(s.b), j = junction(s.a, s.b, JunctionOptions{});
-  for (int level = 1; level <= 5; ++level) {
-    // Level L of the assembly is A, J and B each at level L.
-    EXPECT_EQ(count_pieces(all.automaton, level),
-              count_pieces(a.automaton, level) + count_pieces(j.automaton, level) + count_pieces(b.automaton, level));
-    // Welded, the three are one disc: no seam between them (a seam would leave boundary edges inside
-    // and raise the Euler characteristic above 1) and no overlap.
-    const MeshCounts c = counts(tessellate_surface(all, level));
-    EXPECT_EQ(c.vertices - c.edges + c.faces, 1) << "level " << level;
-    const MeshCounts cj = counts(tessellate_surface(j, level));
-    EXPECT_EQ(cj.vertices - cj.edges + cj.faces, 1) << "level " << level;
-    // The outline of the disc: the four borders of the three surfaces, each of 2^L edges along u and
-    // the pieces across v on the two sides.
-    EXPECT_EQ(c.boundary, 2 * (1L << level) + 2 * long(count_pieces(all.automaton, level) >> level)) << "level " << level;
-  }
+  expect_one_disc(all, a, b, j);
   // The junction's middle (u, v) = (any, J^w) is the midpoint of A's end and B's start, row by row:
   // at u = 0 it is the midpoint of the two surfaces' corner points there.
   const Eigen::VectorXd m = limit_point(j.automaton, j.automaton.initial, 1);  // u symbol 0, v symbol 1 (J)
@@ -498,25 +505,11 @@ TEST(Junction, BordersOfTwoNaturesAlongUMeetOnAStraightSeam) {
   complete_primitives(b.automaton);
   // A's u automaton is a non-uniform quadratic NURBS, B's a Takagi curve: J adds F_A and F_B per point of u.
   EXPECT_EQ(j.control_points.cols(), 3 * (3 + 2 + 3));
-  ASSERT_EQ(j.automaton.transitions[size_t(j.automaton.initial)].size(), 6u);
-  const int wj = j.automaton.alphabet_size / 2, wa = a.automaton.alphabet_size / 2, wb = b.automaton.alphabet_size / 2;
-  ASSERT_EQ(wj, 3);
-  for (int level = 1; level <= 6; ++level) {
-    const auto j0 = border_pieces(j, level, wj, 0, 0, 0), a1 = border_pieces(a, level, wa, wa - 1, wa - 1, 1);
-    const auto j1 = border_pieces(j, level, wj, 2, wb - 1, 1), b0 = border_pieces(b, level, wb, 0, 0, 0);
-    ASSERT_EQ(j0.size(), size_t(1) << level);
-    ASSERT_EQ(a1.size(), j0.size());
-    ASSERT_EQ(j1.size(), j0.size());
-    ASSERT_EQ(b0.size(), j0.size());
-    double worst = 0, apart = 0;
-    for (const auto& [word, corners] : j0) {
-      worst = std::max({worst, (corners.first - a1.at(word).first).norm(), (corners.second - a1.at(word).second).norm()});
-      worst = std::max({worst, (j1.at(word).first - b0.at(word).first).norm(), (j1.at(word).second - b0.at(word).second).norm()});
-      apart = std::max(apart, (corners.first - j1.at(word).first).norm());
-    }
-    EXPECT_LT(worst, 1e-12) << "level " << level;
-    EXPECT_GT(apart, 1.0) << "the two borders are different curves; level " << level;
-  }
+  std::vector<double> apart;
+  expect_borders_on_the_sides(j, a, b, &apart);
+  ASSERT_EQ(apart.size(), 6u);
+  for (size_t level = 0; level < apart.size(); ++level)
+    EXPECT_GT(apart[level], 1.0) << "the two borders are different curves; level " << level + 1;
   // The middle (v symbol J forever) is the straight segment from X, the middle of the borders' start
   // points, to Y, of their end points, with u as its parameter on both natures' sides: at u = 0, 1/4,
   // 1/2 and 1 (u symbols 0^w, 010^w, 10^w, 1^w), the corners of the deep middle pieces.
@@ -546,16 +539,7 @@ TEST(Junction, TwoNaturesAlongUWeldIntoOneDisc) {
   Cifs all = junction(s.a, s.b, options);
   Cifs a = side_system(s.a), b = side_system(s.b);
   options.sides = false;
-  Cifs j = junction(s.a, s.b, options);
-  for (int level = 1; level <= 5; ++level) {
-    EXPECT_EQ(count_pieces(all.automaton, level),
-              count_pieces(a.automaton, level) + count_pieces(j.automaton, level) + count_pieces(b.automaton, level));
-    const MeshCounts c = counts(tessellate_surface(all, level));
-    EXPECT_EQ(c.vertices - c.edges + c.faces, 1) << "level " << level;
-    const MeshCounts cj = counts(tessellate_surface(j, level));
-    EXPECT_EQ(cj.vertices - cj.edges + cj.faces, 1) << "level " << level;
-    EXPECT_EQ(c.boundary, 2 * (1L << level) + 2 * long(count_pieces(all.automaton, level) >> level)) << "level " << level;
-  }
+  expect_one_disc(all, a, b, junction(s.a, s.b, options));
 }
 
 // A curve automaton on three points that splits its quadratic Bezier arc at t = 0.3 (de Casteljau):

@@ -91,7 +91,8 @@ std::vector<Eigen::VectorXd> linear_parameter(const Automaton& a) {
 // The product of two u automata of different natures with a curve automaton W across: control point l
 // of W's state w follows nature type[w][l] (0: ua's, 1: ub's), so a state is (w, the ua state, the ub
 // state), -1 for a nature w does not use, with |u state| x |w| control points (index iu * |w| + l; a
-// state using both natures needs u states of equal sizes). On u symbol a and W's transition T to w',
+// state using both natures needs u states of equal sizes: the initial pair's are the caller's to check,
+// every pair reached is checked here, as are paired states that split into other symbols). On u symbol a and W's transition T to w',
 // every target row follows its own nature: the matrix is the sum over the natures n of
 // kron(M^n_a, T restricted to w''s rows of nature n), and T may only join rows of one nature. The
 // corners of a quad are those of each row's nature, so when every row has nature 0 this is
@@ -117,14 +118,12 @@ Automaton typed_product(const Automaton& ua, const Automaton& ub, const Automato
   for (size_t i = 0; i < queue.size(); ++i) {
     const Key key = queue[i];
     const State& sw = w.states[size_t(key[0])];
+    // Both natures' u states have one size: the caller checks the initial pair, the transitions below the rest.
     int n_u = -1;
     std::string u_name;
     for (int n = 0; n < 2; ++n) {
       if (key[1 + n] < 0) continue;
       const State& su = u[n]->states[size_t(key[1 + n])];
-      if (n_u >= 0 && su.control_points != n_u)
-        throw InvalidInput("the junction's u automata differ in size where they meet (" + std::to_string(n_u) + " and " +
-                           std::to_string(su.control_points) + " control points)");
       n_u = su.control_points;
       u_name += (u_name.empty() ? "" : "|") + (su.name.empty() ? std::to_string(key[1 + n]) : su.name);
     }

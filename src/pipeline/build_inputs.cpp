@@ -497,12 +497,13 @@ class Builder {
     out_.report = VoronoiSpheresReport{points_k.points.size(), s.centers_mm.size()};
   }
 
-  // `refine` (voronoi_tiles, voronoi_foam): the partition's fractal cells, each replaced by its children while
-  // the field at its generator asks for it, every tile drawn with `level` levels of detail; part.level's colours
-  // become the tiles. Returns the tiles' starting colours and counts per level. The field is read at each tile's
-  // generator where the compact tile is drawn (its unwrapped position).
+  // `refine` of voronoi_tiles (the foam's is voronoi::refined_walls): the partition's fractal cells, each
+  // replaced by its children while the field at its generator asks for it, every tile drawn with `level` levels
+  // of detail; part.level's colours become the tiles, with the unwrapped positions the compact tiles are drawn
+  // at. Returns the tiles' starting colours and counts per level. The field is read at each tile's generator
+  // where the compact tile is drawn (its unwrapped position).
   voronoi::RefinedLevel refine(Partition& part, const VoronoiPartition& partition, const GradeField& field,
-                               int levels, bool keep_unwrapped) {
+                               int levels) {
     const voronoi::TorusPlacement& place = part.place;
     try {
       voronoi::RefinedLevel refined = voronoi::refine_level(
@@ -511,7 +512,7 @@ class Builder {
             const Vec3d p = place.to_mm(x[0], x[1], place.dimension == 3 ? x[2] : 0.0);
             return field.at(p) > double(l + 1) / double(levels + 1);
           },
-          keep_unwrapped);
+          true);
       part.level = std::move(refined.level);
       return refined;
     } catch (const ResourceLimit& e) {
@@ -529,7 +530,7 @@ class Builder {
     for (size_t c = 0; c < keep.size(); ++c) tile_colour[c] = int(c);
     std::vector<int> tiles_per_level;
     if (v.refine_levels) {
-      voronoi::RefinedLevel refined = refine(part, v.partition, v.refine, v.refine_levels, true);
+      voronoi::RefinedLevel refined = refine(part, v.partition, v.refine, v.refine_levels);
       tile_colour = std::move(refined.tile_colour);
       tiles_per_level = std::move(refined.tiles_per_level);
     }

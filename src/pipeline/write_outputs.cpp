@@ -266,8 +266,9 @@ RunReport write_outputs(const Recipe& recipe, const Plan& plan, Evaluation&& eva
           throw InvalidInput(recipe.file + ": \"" + object + "\" is empty: nothing is left to export");
       }
       volume = Volume();
-      // Loose pieces: separate bodies below the recipe's size, found on the first surface (the others
-      // differ only by their deviation) and, with "fix", removed from every one.
+      // Loose pieces: separate bodies below the recipe's size, reported from the first surface (the others
+      // differ only by their deviation) and, with "fix", removed from every one (otherwise only the first
+      // is looked at).
       if (printability && recipe.printability.min_piece_mm3 > 0 && !surfaces.empty()) {
         timer.start("printability");
         const PrintabilitySettings& settings = recipe.printability;
@@ -290,7 +291,8 @@ RunReport write_outputs(const Recipe& recipe, const Plan& plan, Evaluation&& eva
                                                " mm3 (separate bodies: debris in the powder or resin)");
             first = false;
           }
-          if (fix) remove_components(surface.mesh, loose);
+          if (!fix) break;
+          remove_components(surface.mesh, loose);
         }
         timer.start("mesh");
       }

@@ -97,8 +97,8 @@ std::vector<Cell> shape_cells(const Rules& rules) { return periodic_cells(genera
 
 // Every face between two generators of a scaled level that wanted(i, j, shift) asks for (symmetric: the
 // same answer from j with -shift), once, from the generator of the lower lattice key: emit(i, j, shift,
-// facet) with the facet around i's wrapped position and shift the whole periods from i's wrapped copy to
-// the copy of j across the face. Returns how many generators had a face asked for.
+// make_facet), make_facet() building the facet around i's wrapped position (only when called) and shift
+// the whole periods from i's wrapped copy to the copy of j across the face. Returns how many generators had a face asked for.
 template <class Wanted, class Emit>
 size_t scan_faces(const Rules& rules, const Level& level, const Lattice& lattice, const std::vector<Cell>& cells,
                   Wanted&& wanted, Emit&& emit) {
@@ -125,13 +125,15 @@ size_t scan_faces(const Rules& rules, const Level& level, const Lattice& lattice
       if (!wanted(i, other, shift)) continue;
       boundary = true;
       if (other_key < lattice.key[i]) continue;  // the neighbour carries this face
-      std::vector<Point3> facet;
-      for (const Point3& v : cell.faces[f]) {
-        Point3 q{0, 0, 0};
-        for (int j = 0; j < n; ++j) q[size_t(j)] = x[size_t(j)] + (v[size_t(j)] - p[size_t(j)]) * scale;
-        facet.push_back(q);
-      }
-      emit(i, other, shift, std::move(facet));
+      emit(i, other, shift, [&] {
+        std::vector<Point3> facet;
+        for (const Point3& v : cell.faces[f]) {
+          Point3 q{0, 0, 0};
+          for (int j = 0; j < n; ++j) q[size_t(j)] = x[size_t(j)] + (v[size_t(j)] - p[size_t(j)]) * scale;
+          facet.push_back(q);
+        }
+        return facet;
+      });
     }
     if (boundary) ++boundary_generators;
   }
@@ -150,7 +152,8 @@ Walls extract_walls(const Rules& rules, const Level& level) {
   walls.boundary_generators = scan_faces(
       rules, level, lattice, cells,
       [&](size_t i, size_t j, const std::array<int, 3>&) { return level.colours[i] != level.colours[j]; },
-      [&](size_t i, size_t j, const std::array<int, 3>&, std::vector<Point3>&& facet) {
+      [&](size_t i, size_t j, const std::array<int, 3>&, auto&& make_facet) {
+        std::vector<Point3> facet = make_facet();
         walls.measure += facet_measure(facet, n);
         walls.facets.push_back(std::move(facet));
         walls.colours.push_back({level.colours[i], level.colours[j]});
@@ -194,7 +197,7 @@ RefinedWalls refined_walls(const Rules& rules, int detail, int levels, const std
   size_t candidate_count = 0;
   std::array<int, 3> reach_min{0, 0, 0}, reach_max{0, 0, 0};
   const size_t boundary = scan_faces(rules, fine, lattice, cells, wanted,
-                                     [&](size_t i, size_t j, const std::array<int, 3>& shift, std::vector<Point3>&&) {
+                                     [&](size_t i, size_t j, const std::array<int, 3>& shift, auto&&) {
                                        ++candidate_count;
                                        for (int k = 0; k < n; ++k) {
                                          const int ri = -s[i][size_t(k)], rj = shift[size_t(k)] - s[j][size_t(k)];
@@ -283,8 +286,8 @@ RefinedWalls refined_walls(const Rules& rules, int detail, int levels, const std
   std::vector<Candidate> candidates;
   candidates.reserve(candidate_count);
   scan_faces(rules, fine, lattice, cells, wanted,
-             [&](size_t i, size_t j, const std::array<int, 3>& shift, std::vector<Point3>&& facet) {
-               candidates.push_back({uint32_t(i), uint32_t(j), shift, std::move(facet)});
+             [&](size_t i, size_t j, const std::array<int, 3>& shift, auto&& make_facet) {
+               candidates.push_back({uint32_t(i), uint32_t(j), shift, make_facet()});
              });
   // Each period's walls: the candidates whose two sides end in different tiles there (copies of one tile
   // that meet have no wall between them, as in the periodic walls).
