@@ -1002,6 +1002,86 @@ TriMesh read_mesh(const std::string& path, MeshFormat format, const ReadOptions&
   return mesh;
 }
 
+struct StlWriter::Impl {
+  std::string path;
+  std::FILE* file = nullptr;
+  std::vector<unsigned char> buffer;
+  uint64_t triangles = 0;
+  bool finished = false;
+
+  [[noreturn]] void fail() {
+    const int error = errno;
+    if (file) std::fclose(file);
+    file = nullptr;
+    remove_partial(path);
+    throw IoError(cat("cannot write '", path, "': ", std::strerror(error)));
+  }
+  void flush() {
+    if (!buffer.empty() && std::fwrite(buffer.data(), 1, buffer.size(), file) != buffer.size()) fail();
+    buffer.clear();
+  }
+};
+
+StlWriter::StlWriter(const std::string& path, const std::string& header) : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  m.path = path;
+  m.file = std::fopen(path.c_str(), "wb");
+  if (!m.file) throw IoError(cat("cannot create '", path, "': ", std::strerror(errno)));
+  m.buffer.reserve(kIoChunkBytes);
+  // Other programs take a binary STL whose header begins with "solid" for an ASCII one.
+  std::string text = starts_with_solid(header) ? "binary " + header : header;
+  text.resize(80, ' ');
+  m.buffer.insert(m.buffer.end(), text.begin(), text.end());
+  m.buffer.resize(kStlHeaderBytes);  // the count: written by finish()
+}
+
+StlWriter::~StlWriter() {
+  if (impl_->finished) return;
+  if (impl_->file) std::fclose(impl_->file);
+  remove_partial(impl_->path);
+}
+
+void StlWriter::add(const std::array<Vec3d, 3>& corners) {
+  Impl& m = *impl_;
+  if (m.triangles == std::numeric_limits<uint32_t>::max()) {
+    throw ResourceLimit(cat("cannot write '", m.path, "': more than ", m.triangles,
+                            " triangles are more than a binary STL holds"));
+  }
+  float p[3][3];
+  Vec3d corner[3];
+  for (int v = 0; v < 3; ++v) {
+    for (int axis = 0; axis < 3; ++axis) p[v][axis] = static_cast<float>(corners[size_t(v)][axis]);
+    corner[v] = {p[v][0], p[v][1], p[v][2]};
+  }
+  // The normal of the triangle as stored (float), so that it matches what readers see.
+  Vec3d normal = cross(corner[1] - corner[0], corner[2] - corner[0]);
+  double length = norm(normal);
+  normal = length > 0 && std::isfinite(length) ? normal / length : Vec3d{};
+  size_t at = m.buffer.size();
+  m.buffer.resize(at + kStlRecordBytes);
+  unsigned char* record = m.buffer.data() + at;
+  for (int axis = 0; axis < 3; ++axis) store_le_float(static_cast<float>(normal[axis]), record + 4 * axis);
+  for (int v = 0; v < 3; ++v)
+    for (int axis = 0; axis < 3; ++axis) store_le_float(p[v][axis], record + 12 + 12 * v + 4 * axis);
+  record[48] = record[49] = 0;
+  ++m.triangles;
+  if (m.buffer.size() + kStlRecordBytes > kIoChunkBytes) m.flush();
+}
+
+uint64_t StlWriter::triangles() const { return impl_->triangles; }
+
+void StlWriter::finish() {
+  Impl& m = *impl_;
+  m.flush();
+  unsigned char count[4];
+  store_le32(static_cast<uint32_t>(m.triangles), count);
+  if (std::fseek(m.file, 80, SEEK_SET) != 0 || std::fwrite(count, 1, 4, m.file) != 4) m.fail();
+  const int closed = std::fclose(m.file);
+  m.file = nullptr;
+  if (closed != 0) m.fail();
+  m.finished = true;
+}
+
 void write_stl(const std::string& path, const TriMesh& mesh, const std::string& header) {
   if (mesh.triangles.size() > std::numeric_limits<uint32_t>::max()) {
     throw ResourceLimit(cat("cannot write '", path, "': ", mesh.triangles.size(),
@@ -1015,61 +1095,44 @@ void write_stl(const std::string& path, const TriMesh& mesh, const std::string& 
       }
     }
   }
+  StlWriter writer(path, header);
+  for (const auto& t : mesh.triangles)
+    writer.add({mesh.positions_mm[t[0]], mesh.positions_mm[t[1]], mesh.positions_mm[t[2]]});
+  writer.finish();
+}
+
+std::vector<std::array<Vec3d, 3>> read_stl_triangles(const std::string& path, uint64_t first, uint64_t count) {
   struct Closer {
     void operator()(std::FILE* f) const { std::fclose(f); }
   };
-  std::unique_ptr<std::FILE, Closer> file(std::fopen(path.c_str(), "wb"));
-  if (!file) throw IoError(cat("cannot create '", path, "': ", std::strerror(errno)));
-  auto write_failed = [&] {
-    int error = errno;
-    file.reset();
-    remove_partial(path);
-    throw IoError(cat("cannot write '", path, "': ", std::strerror(error)));
-  };
-
-  std::vector<unsigned char> buffer;
-  buffer.reserve(kIoChunkBytes);
-  // Other programs take a binary STL whose header begins with "solid" for an ASCII one.
-  std::string text = starts_with_solid(header) ? "binary " + header : header;
-  text.resize(80, ' ');
-  buffer.insert(buffer.end(), text.begin(), text.end());
-  buffer.resize(kStlHeaderBytes);
-  store_le32(static_cast<uint32_t>(mesh.triangles.size()), buffer.data() + 80);
-  for (const auto& triangle : mesh.triangles) {
-    float p[3][3];
-    Vec3d corner[3];
-    for (int v = 0; v < 3; ++v) {
-      const Vec3d& q = mesh.positions_mm[triangle[v]];
-      for (int axis = 0; axis < 3; ++axis) p[v][axis] = static_cast<float>(q[axis]);
-      corner[v] = {p[v][0], p[v][1], p[v][2]};
-    }
-    // The normal of the triangle as stored (float), so that it matches what readers see.
-    Vec3d normal = cross(corner[1] - corner[0], corner[2] - corner[0]);
-    double length = norm(normal);
-    normal = length > 0 && std::isfinite(length) ? normal / length : Vec3d{};
-    size_t at = buffer.size();
-    buffer.resize(at + kStlRecordBytes);
-    unsigned char* record = buffer.data() + at;
-    for (int axis = 0; axis < 3; ++axis) {
-      store_le_float(static_cast<float>(normal[axis]), record + 4 * axis);
-    }
-    for (int v = 0; v < 3; ++v) {
-      for (int axis = 0; axis < 3; ++axis) {
-        store_le_float(p[v][axis], record + 12 + 12 * v + 4 * axis);
-      }
-    }
-    record[48] = record[49] = 0;
-    if (buffer.size() + kStlRecordBytes > kIoChunkBytes) {
-      if (std::fwrite(buffer.data(), 1, buffer.size(), file.get()) != buffer.size()) write_failed();
-      buffer.clear();
-    }
+  std::unique_ptr<std::FILE, Closer> file(std::fopen(path.c_str(), "rb"));
+  if (!file) throw IoError(cat("cannot open '", path, "': ", std::strerror(errno)));
+  unsigned char head[kStlHeaderBytes];
+  if (std::fread(head, 1, kStlHeaderBytes, file.get()) != kStlHeaderBytes)
+    throw InvalidInput(cat(path, ": not a binary STL (shorter than its 84-byte header)"));
+  const uint64_t total = uint64_t(head[80]) | uint64_t(head[81]) << 8 | uint64_t(head[82]) << 16 | uint64_t(head[83]) << 24;
+  if (first > total || count > total - first)
+    throw InvalidInput(cat(path, ": triangles ", first, " to ", first + count, " asked of ", total));
+  if (std::fseek(file.get(), long(kStlHeaderBytes + first * kStlRecordBytes), SEEK_SET) != 0)
+    throw IoError(cat("cannot read '", path, "': ", std::strerror(errno)));
+  std::vector<std::array<Vec3d, 3>> out(count);
+  std::vector<unsigned char> buffer(kIoChunkBytes / kStlRecordBytes * kStlRecordBytes);
+  for (uint64_t done = 0; done < count;) {
+    const uint64_t n = std::min<uint64_t>(count - done, buffer.size() / kStlRecordBytes);
+    if (std::fread(buffer.data(), 1, n * kStlRecordBytes, file.get()) != n * kStlRecordBytes)
+      throw InvalidInput(cat(path, ": ends before triangle ", first + done + n, " of ", total));
+    for (uint64_t i = 0; i < n; ++i)
+      for (int v = 0; v < 3; ++v)
+        for (int axis = 0; axis < 3; ++axis) {
+          float f;
+          const unsigned char* q = buffer.data() + i * kStlRecordBytes + 12 + 12 * v + 4 * axis;
+          const uint32_t bits = uint32_t(q[0]) | uint32_t(q[1]) << 8 | uint32_t(q[2]) << 16 | uint32_t(q[3]) << 24;
+          std::memcpy(&f, &bits, 4);
+          out[done + i][size_t(v)][axis] = f;
+        }
+    done += n;
   }
-  if (std::fwrite(buffer.data(), 1, buffer.size(), file.get()) != buffer.size()) write_failed();
-  if (std::fclose(file.release()) != 0) {
-    int error = errno;
-    remove_partial(path);
-    throw IoError(cat("cannot write '", path, "': ", std::strerror(error)));
-  }
+  return out;
 }
 
 }  // namespace lacuna

@@ -3,7 +3,9 @@
 // the line or byte offset, and what was expected; they never crash on malformed input.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -38,6 +40,27 @@ TriMesh read_mesh(const std::string& path, MeshFormat format, const ReadOptions&
 // Writes a binary STL (float32 coordinates, little-endian). The 80-byte header holds `header`
 // (truncated). Throws IoError on failure.
 void write_stl(const std::string& path, const TriMesh& mesh, const std::string& header);
+
+// A binary STL written triangle by triangle, as they come (the count goes in when it is finished):
+// the same bytes write_stl writes for the same triangles. A writer not finished removes its file.
+class StlWriter {
+ public:
+  StlWriter(const std::string& path, const std::string& header);  // throws IoError
+  ~StlWriter();
+  StlWriter(const StlWriter&) = delete;
+  StlWriter& operator=(const StlWriter&) = delete;
+  void add(const std::array<Vec3d, 3>& corners);  // counter-clockwise seen from outside; throws IoError, ResourceLimit
+  void finish();                                  // throws IoError
+  uint64_t triangles() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Triangles [first, first + count) of a binary STL, in file order (float32 corners as written).
+// Throws IoError, or InvalidInput when the file holds fewer.
+std::vector<std::array<Vec3d, 3>> read_stl_triangles(const std::string& path, uint64_t first, uint64_t count);
 
 struct ThreeMfInfo {
   std::string object_name = "part";

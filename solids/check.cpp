@@ -2,6 +2,7 @@
 
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
+#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <array>
@@ -10,6 +11,7 @@
 #include <numeric>
 #include <unordered_map>
 
+#include "errors.h"
 #include "solids/components.h"
 #include "solids/exact.h"
 #include "solids/mesh_topology.h"
@@ -42,17 +44,13 @@ bool ray_crosses(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& p)
 // For every component, how many other components enclose it: the parity of the crossings of a
 // ray from one of its points along +x with each other component. Triangles are matched to the
 // probes through a grid over (y, z), so the cost is one pass over the triangles.
-std::vector<uint32_t> nesting_depths(const TriMesh& mesh, const std::vector<uint32_t>& component_of, size_t nc) {
-  std::vector<uint32_t> depth(nc, 0);
-  if (nc < 2) return depth;
-  std::vector<Vec3d> probe(nc);
-  std::vector<uint8_t> has_probe(nc, 0);
-  for (const auto& t : mesh.triangles) {
-    uint32_t c = component_of[t[0]];
-    if (has_probe[c]) continue;
-    probe[c] = (mesh.positions_mm[t[0]] + mesh.positions_mm[t[1]] + mesh.positions_mm[t[2]]) / 3.0;
-    has_probe[c] = 1;
-  }
+// The (probe, component) pairs whose ray from the probe along +x crosses the component's surface
+// an odd number of times, sorted, a probe's own component (own[q]) aside.
+std::vector<std::pair<uint32_t, uint32_t>> odd_crossings(const TriMesh& mesh, const std::vector<uint32_t>& component_of,
+                                                         const std::vector<Vec3d>& probe,
+                                                         const std::vector<uint32_t>& own) {
+  const size_t nc = probe.size();
+  if (nc == 0) return {};
   Box3 box;
   for (const Vec3d& p : probe) box.expand(p);
   const double cell = std::max({box.size().y, box.size().z, 1e-9}) / std::max(1.0, std::ceil(std::sqrt(double(nc))));
@@ -85,20 +83,37 @@ std::vector<uint32_t> nesting_depths(const TriMesh& mesh, const std::vector<uint
           auto it = probes_in_cell.find(key(i, j));
           if (it == probes_in_cell.end()) continue;
           for (uint32_t q : it->second)
-            if (q != owner && probe[q].x <= std::max({a.x, b.x, c.x}) && ray_crosses(a, b, c, probe[q]))
+            if (own[q] != owner && probe[q].x <= std::max({a.x, b.x, c.x}) && ray_crosses(a, b, c, probe[q]))
               out.push_back({q, owner});
         }
     }
   });
-  std::vector<std::pair<uint32_t, uint32_t>> all;
+  std::vector<std::pair<uint32_t, uint32_t>> all, odd;
   for (const auto& c : crossings) all.insert(all.end(), c.begin(), c.end());
   std::sort(all.begin(), all.end());
   for (size_t i = 0; i < all.size();) {
     size_t j = i;
     while (j < all.size() && all[j] == all[i]) ++j;
-    depth[all[i].first] += (j - i) % 2;
+    if ((j - i) % 2) odd.push_back(all[i]);
     i = j;
   }
+  return odd;
+}
+
+std::vector<uint32_t> nesting_depths(const TriMesh& mesh, const std::vector<uint32_t>& component_of, size_t nc) {
+  std::vector<uint32_t> depth(nc, 0);
+  if (nc < 2) return depth;
+  std::vector<Vec3d> probe(nc);
+  std::vector<uint8_t> has_probe(nc, 0);
+  for (const auto& t : mesh.triangles) {
+    uint32_t c = component_of[t[0]];
+    if (has_probe[c]) continue;
+    probe[c] = (mesh.positions_mm[t[0]] + mesh.positions_mm[t[1]] + mesh.positions_mm[t[2]]) / 3.0;
+    has_probe[c] = 1;
+  }
+  std::vector<uint32_t> own(nc);
+  std::iota(own.begin(), own.end(), 0u);
+  for (const auto& [q, c] : odd_crossings(mesh, component_of, probe, own)) ++depth[q];
   return depth;
 }
 
@@ -506,6 +521,323 @@ MeshCheckReport check_mesh(const TriMesh& mesh, const CheckOptions& options) {
     r.self_intersecting = self_intersects(mesh, edges, corners, degenerate, progress);
     r.self_intersections_checked = true;
   }
+  return r;
+}
+
+
+// The mesh comes in chunks W_0, W_1, ... and is checked two chunks at a time (a window), so every
+// pair of triangles that can touch is in some window: a chunk lies above (in z) every triangle two
+// chunks before it, which is tested. A vertex, an edge or a face is counted in the first window
+// holding it (whose first chunk has one of its faces, or the last window); an edge open in a
+// window is open in the mesh when the window after it (holding its face's other neighbours) finds it
+// open too; components are joined across windows through the vertices of their shared chunk; a
+// component's nesting comes from a ray from one of its faces in the window that holds every
+// triangle crossing the ray's plane.
+struct ChunkedCheck::Impl {
+  CheckOptions options;
+  MeshCheckReport r;
+  std::vector<std::array<Vec3d, 3>> previous;  // the last chunk given
+  size_t chunks = 0;
+  double z_max_before = -HUGE_VAL;  // the top of the chunk before `previous`
+  double z_max_previous = -HUGE_VAL;
+  bool done = false;
+  bool separated = true;            // every chunk above the one two before it
+  bool fans_checked = true, intersections_checked = true;
+  using Edge = std::array<float, 6>;
+  std::vector<Edge> open_ahead;     // open edges of the last window with a face in its second chunk, sorted
+  // The vertices of `previous` (as the last window numbered them) and the component node of each.
+  std::vector<std::array<float, 3>> seam_points;
+  std::vector<uint32_t> seam_nodes;
+  std::vector<uint8_t> seam_counted;                    // counted in the last window
+  std::vector<std::pair<uint32_t, uint32_t>> seam_match;  // (vertex here, its node there)
+  // Component nodes (one per window component), joined across windows.
+  std::vector<uint32_t> parent;
+  std::vector<long double> volume6;
+  std::vector<int64_t> euler;
+  struct Probe {
+    uint32_t node;
+  };
+  std::vector<Probe> probes;
+  std::vector<std::pair<uint32_t, uint32_t>> crossings;  // (probe, node) crossed an odd number of times
+  Vec3d origin;
+  bool has_origin = false;
+  long double area2 = 0;
+
+  uint32_t find(uint32_t a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  }
+  void join(uint32_t a, uint32_t b) {
+    a = find(a), b = find(b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  }
+
+  static Edge edge_of(const TriMesh& m, uint32_t h) {
+    const Vec3d &a = m.positions_mm[half_edge_from(m, h)], &b = m.positions_mm[half_edge_to(m, h)];
+    return {float(a.x), float(a.y), float(a.z), float(b.x), float(b.y), float(b.z)};
+  }
+
+  // The window of chunks a (the first) and b (possibly empty); `last`: no chunk follows b.
+  void window(const std::vector<std::array<Vec3d, 3>>& a, const std::vector<std::array<Vec3d, 3>>& b, bool first,
+              bool last) {
+    const size_t na = a.size(), nf = na + b.size();
+    std::vector<std::array<float, 3>> points;
+    points.reserve(3 * nf);
+    uint64_t non_finite = 0;
+    for (size_t f = 0; f < nf; ++f)
+      for (const Vec3d& p : f < na ? a[f] : b[f - na]) {
+        if (!is_finite(p)) ++non_finite;
+        points.push_back({float(p.x), float(p.y), float(p.z)});
+      }
+    if (non_finite) {
+      r.non_finite_vertices += non_finite;
+      fans_checked = intersections_checked = false;
+      return;
+    }
+    std::vector<std::array<float, 3>> unique_points = points;
+    tbb::parallel_sort(unique_points.begin(), unique_points.end());
+    unique_points.erase(std::unique(unique_points.begin(), unique_points.end()), unique_points.end());
+    TriMesh m;
+    m.positions_mm.resize(unique_points.size());
+    for (size_t v = 0; v < unique_points.size(); ++v)
+      m.positions_mm[v] = {unique_points[v][0], unique_points[v][1], unique_points[v][2]};
+    m.triangles.resize(nf);
+    tbb::parallel_for(size_t(0), nf, [&](size_t f) {
+      for (int k = 0; k < 3; ++k)
+        m.triangles[f][size_t(k)] = uint32_t(std::lower_bound(unique_points.begin(), unique_points.end(), points[3 * f + size_t(k)]) -
+                                             unique_points.begin());
+    });
+    std::vector<std::array<float, 3>>().swap(points);
+    const size_t nv = m.positions_mm.size();
+    auto counted_face = [&](size_t f) { return f < na || last; };
+    // Per vertex: 1 a face in the first chunk, 2 a face in the second.
+    std::vector<uint8_t> in_chunk(nv, 0);
+    for (size_t f = 0; f < nf; ++f)
+      for (uint32_t v : m.triangles[f]) in_chunk[v] |= f < na ? 1 : 2;
+    // A first-chunk vertex the last window had a first-chunk face at was counted there.
+    std::vector<uint8_t> seen_before(nv, 0);
+    for (uint32_t v = 0; v < nv; ++v) {
+      if (!(in_chunk[v] & 1)) continue;
+      const std::array<float, 3> key{float(m.positions_mm[v].x), float(m.positions_mm[v].y), float(m.positions_mm[v].z)};
+      auto it = std::lower_bound(seam_points.begin(), seam_points.end(), key);
+      if (it != seam_points.end() && *it == key) {
+        const size_t at = size_t(it - seam_points.begin());
+        seen_before[v] = seam_counted[at];
+        seam_match.push_back({v, seam_nodes[at]});
+      }
+    }
+    auto counted_vertex = [&](uint32_t v) { return ((in_chunk[v] & 1) || last) && !seen_before[v]; };
+    if (!has_origin && nv) {
+      origin = m.positions_mm[0];
+      has_origin = true;
+    }
+    // Faces.
+    std::vector<uint8_t> degenerate(nf, 0);
+    for (size_t f = 0; f < nf; ++f) {
+      const auto& t = m.triangles[f];
+      if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2] ||
+          exact::collinear(m.positions_mm[t[0]], m.positions_mm[t[1]], m.positions_mm[t[2]])) {
+        degenerate[f] = 1;
+        r.degenerate_faces += counted_face(f);
+      }
+      if (counted_face(f)) {
+        ++r.triangles;
+        for (uint32_t v : t) r.bounding_box.expand(m.positions_mm[v]);
+      }
+    }
+    // Edges.
+    const VertexCorners corners = vertex_corners(m);
+    const EdgeTopology edges = edge_topology(m, corners);
+    auto has_first_face = [&](uint32_t h) {
+      const uint32_t u = half_edge_from(m, h), w = half_edge_to(m, h);
+      for (uint64_t i = corners.offsets[u]; i < corners.offsets[u + 1]; ++i) {
+        const uint32_t f = corners.corners[i] / 3;
+        const auto& t = m.triangles[f];
+        if ((t[0] == w || t[1] == w || t[2] == w) && counted_face(f)) return true;
+      }
+      return false;
+    };
+    for (uint32_t h : edges.non_manifold) r.non_manifold_edges += has_first_face(h);
+    for (uint32_t h : edges.misoriented) r.misoriented_edges += has_first_face(h);
+    std::vector<uint8_t> on_open(nv, 0);
+    std::vector<Edge> ahead;
+    for (uint32_t h : edges.boundary) {
+      on_open[half_edge_from(m, h)] = on_open[half_edge_to(m, h)] = 1;
+      if (h / 3 >= na) ahead.push_back(edge_of(m, h));
+    }
+    // An edge open here with its face in the first chunk was closed in the last window (and counted
+    // there) unless that window found it open too.
+    std::vector<uint8_t> counted_before(3 * nf, 0);
+    for (uint32_t h : edges.boundary) {
+      if (h / 3 >= na) continue;
+      if (first || std::binary_search(open_ahead.begin(), open_ahead.end(), edge_of(m, h))) ++r.boundary_edges;
+      else counted_before[h] = 1;
+    }
+    std::sort(ahead.begin(), ahead.end());
+    if (last) {
+      r.boundary_edges += ahead.size();
+      ahead.clear();
+    }
+    open_ahead.swap(ahead);
+    for (uint32_t h : edges.non_manifold) on_open[half_edge_from(m, h)] = on_open[half_edge_to(m, h)] = 1;
+    for (uint32_t h : edges.misoriented) on_open[half_edge_from(m, h)] = on_open[half_edge_to(m, h)] = 1;
+    // Vertices: fans where every face of the vertex is here.
+    const bool edges_clean = edges.non_manifold_edges == 0 && edges.misoriented_edges == 0;
+    uint64_t bad_fans = 0;
+    if (edges_clean) {
+      const std::vector<uint32_t> fans = vertex_fans(m, edges, corners);
+      for (uint32_t v = 0; v < nv; ++v)
+        if (!on_open[v] && fans[v] > 1) {
+          ++bad_fans;
+          r.non_manifold_vertices += counted_vertex(v);
+        }
+    } else {
+      fans_checked = false;
+    }
+    // Components, joined to the last window's through the first chunk's vertices.
+    const VertexComponents components = vertex_components(m);
+    const uint32_t base = uint32_t(parent.size());
+    for (uint32_t c = 0; c < components.count; ++c) parent.push_back(base + c);
+    volume6.resize(parent.size(), 0);
+    euler.resize(parent.size(), 0);
+    for (uint32_t v = 0; v < nv; ++v) {
+      if (!counted_vertex(v)) continue;
+      ++r.vertices;
+      ++euler[base + components.of_vertex[v]];
+    }
+    for (size_t h = 0; h < 3 * nf; ++h) {
+      const size_t f = h / 3;
+      if (!counted_face(f)) continue;
+      const uint32_t g = edges.opposite[h];
+      // Once per edge: at its half-edge here, or at the smaller of two here.
+      if (g != kNoHalfEdge && counted_face(g / 3) && g < h) continue;
+      if (counted_before[h]) continue;
+      ++r.edges;
+      --euler[base + components.of_vertex[half_edge_from(m, uint32_t(h))]];
+    }
+    for (size_t f = 0; f < nf; ++f) {
+      if (!counted_face(f)) continue;
+      const auto& t = m.triangles[f];
+      const uint32_t c = base + components.of_vertex[t[0]];
+      ++euler[c];
+      const Vec3d p0 = m.positions_mm[t[0]] - origin, p1 = m.positions_mm[t[1]] - origin, p2 = m.positions_mm[t[2]] - origin;
+      volume6[c] += dot(p0, cross(p1, p2));
+      area2 += norm(cross(p1 - p0, p2 - p0));
+    }
+    for (const auto& [v, node] : seam_match) join(node, base + components.of_vertex[v]);
+    seam_match.clear();
+    seam_points.clear();
+    seam_nodes.clear();
+    seam_counted.clear();
+    for (uint32_t v = 0; v < nv; ++v)  // sorted: the positions are
+      if (in_chunk[v] & 2) {
+        seam_points.push_back({float(m.positions_mm[v].x), float(m.positions_mm[v].y), float(m.positions_mm[v].z)});
+        seam_nodes.push_back(base + components.of_vertex[v]);
+        seam_counted.push_back(counted_vertex(v) ? 1 : 0);
+      }
+    // Probes: per component, its first face whose plane z = centroid only this window's
+    // triangles cross (a first-chunk face above the chunk before, or a second-chunk face below
+    // the first chunk's top; any second-chunk face in the last window).
+    std::vector<Vec3d> probe;
+    std::vector<uint32_t> own;
+    std::vector<uint8_t> probed(components.count, 0);
+    for (size_t f = 0; f < nf; ++f) {
+      const auto& t = m.triangles[f];
+      const uint32_t c = components.of_vertex[t[0]];
+      if (probed[c]) continue;
+      const Vec3d centroid = (m.positions_mm[t[0]] + m.positions_mm[t[1]] + m.positions_mm[t[2]]) / 3.0;
+      const bool here = f < na ? (first || centroid.z > z_max_before) : (last || centroid.z <= z_max_previous);
+      if (!here) continue;
+      probed[c] = 1;
+      probe.push_back(centroid);
+      own.push_back(c);
+    }
+    const uint32_t probe_base = uint32_t(probes.size());
+    for (uint32_t c : own) probes.push_back({base + c});
+    if (components.count > 1 || !probes.empty())
+      for (const auto& [q, c] : odd_crossings(m, components.of_vertex, probe, own)) crossings.push_back({probe_base + q, base + c});
+    // Self-intersections among the window's faces.
+    if (options.self_intersections && edges_clean && bad_fans == 0) {
+      Progress progress("check", 4 + 16);
+      r.self_intersecting = r.self_intersecting || self_intersects(m, edges, corners, degenerate, progress);
+    } else {
+      intersections_checked = false;
+    }
+  }
+};
+
+ChunkedCheck::ChunkedCheck(const CheckOptions& options) : impl_(std::make_unique<Impl>()) { impl_->options = options; }
+ChunkedCheck::~ChunkedCheck() = default;
+
+void ChunkedCheck::add(std::vector<std::array<Vec3d, 3>> chunk, bool last) {
+  Impl& m = *impl_;
+  if (m.done) throw InternalError("ChunkedCheck::add after the last chunk");
+  double lo = HUGE_VAL, hi = -HUGE_VAL;
+  for (const auto& t : chunk)
+    for (const Vec3d& p : t) {
+      lo = std::min(lo, p.z);
+      hi = std::max(hi, p.z);
+    }
+  if (m.chunks >= 2 && !chunk.empty() && !(lo > m.z_max_before)) m.separated = false;
+  if (m.chunks == 0 && last) m.window(chunk, {}, true, true);
+  if (m.chunks >= 1) m.window(m.previous, chunk, m.chunks == 1, last);
+  ++m.chunks;
+  m.z_max_before = m.z_max_previous;
+  m.z_max_previous = hi;
+  m.previous = std::move(chunk);
+  m.done = last;
+}
+
+MeshCheckReport ChunkedCheck::finish() {
+  Impl& m = *impl_;
+  if (!m.done && m.chunks) throw InternalError("ChunkedCheck::finish before the last chunk");
+  m.previous.clear();
+  MeshCheckReport& r = m.r;
+  // As check_mesh: vertices, orientation and intersections only on a closed surface with clean edges.
+  const bool edges_clean = r.boundary_edges == 0 && r.non_manifold_edges == 0 && r.misoriented_edges == 0;
+  r.vertex_manifold_checked = m.fans_checked && edges_clean;
+  if (!r.vertex_manifold_checked) r.non_manifold_vertices = 0;
+  r.orientation_checked = r.vertex_manifold_checked;
+  r.self_intersections_checked =
+      m.intersections_checked && m.separated && r.vertex_manifold_checked && r.non_manifold_vertices == 0;
+  if (!r.self_intersections_checked) r.self_intersecting = false;
+  const size_t nodes = m.parent.size();
+  std::vector<long double> volume6(nodes, 0);
+  std::vector<int64_t> euler(nodes, 0);
+  for (uint32_t c = 0; c < nodes; ++c) {
+    const uint32_t root = m.find(c);
+    volume6[root] += m.volume6[c];
+    euler[root] += m.euler[c];
+  }
+  long double total6 = 0;
+  std::vector<uint32_t> probe_of(nodes, UINT32_MAX);
+  for (uint32_t q = 0; q < m.probes.size(); ++q) {
+    const uint32_t root = m.find(m.probes[q].node);
+    if (probe_of[root] == UINT32_MAX) probe_of[root] = q;
+  }
+  std::vector<std::pair<uint32_t, uint32_t>> crossed;  // (probe, root crossed), one per odd crossing
+  for (const auto& [q, node] : m.crossings) {
+    const uint32_t root = m.find(node);
+    if (probe_of[m.find(m.probes[q].node)] == q) crossed.push_back({q, root});
+  }
+  std::sort(crossed.begin(), crossed.end());
+  std::vector<uint32_t> depth(m.probes.size(), 0);
+  for (size_t i = 0; i < crossed.size();) {
+    size_t j = i;
+    while (j < crossed.size() && crossed[j] == crossed[i]) ++j;
+    depth[crossed[i].first] += (j - i) % 2;
+    i = j;
+  }
+  for (uint32_t c = 0; c < nodes; ++c) {
+    if (m.find(c) != c) continue;
+    ++r.components;
+    total6 += volume6[c];
+    r.genus += (2 - euler[c]) / 2;
+    if (r.orientation_checked && probe_of[c] != UINT32_MAX && (volume6[c] > 0) != (depth[probe_of[c]] % 2 == 0))
+      ++r.inward_components;
+  }
+  r.volume_mm3 = double(total6 / 6.0L);
+  r.area_mm2 = double(m.area2 / 2.0L);
   return r;
 }
 

@@ -4,7 +4,9 @@
 // invalid mesh.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -53,5 +55,24 @@ MeshCheckReport check_mesh(const TriMesh& mesh, const CheckOptions& options = {}
 // mesh_components() (solids/components.h): the parity of exact ray crossings. The components must
 // not intersect each other.
 std::vector<uint32_t> component_depths(const TriMesh& mesh);
+
+// check_mesh's checks of a mesh too large to hold, read in chunks of whole triangles as written
+// (corners as float triples, shared corners equal), two chunks at a time: so every triangle of a
+// chunk must lie above (in z) every triangle two chunks before it, or self-intersections count as
+// not checked. The figures are the whole mesh's (the volume up to rounding).
+class ChunkedCheck {
+ public:
+  explicit ChunkedCheck(const CheckOptions& options = {});
+  ~ChunkedCheck();
+  ChunkedCheck(const ChunkedCheck&) = delete;
+  ChunkedCheck& operator=(const ChunkedCheck&) = delete;
+  // The next chunk, in order; `last` for the last one.
+  void add(std::vector<std::array<Vec3d, 3>> chunk, bool last);
+  MeshCheckReport finish();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace lacuna

@@ -242,6 +242,11 @@ BlockExtractor::~BlockExtractor() = default;
 
 size_t BlockExtractor::block_count() const { return impl_->origins.size(); }
 
+std::array<int64_t, 3> BlockExtractor::block_origin(size_t i) const {
+  const openvdb::Coord o = impl_->origins.at(i);
+  return {int64_t(o.x()), int64_t(o.y()), int64_t(o.z())};
+}
+
 void BlockExtractor::extract(size_t i, SurfaceBlock& out) const {
   const Impl& m = *impl_;
   const int n = m.size, n1 = n + 1;

@@ -3,6 +3,7 @@
 // construction (see README, "Why marching tetrahedra").
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -55,6 +56,8 @@ class BlockExtractor {
 
   // The blocks the narrow band reaches, in increasing order of their origin.
   size_t block_count() const;
+  // Block i's lowest voxel.
+  std::array<int64_t, 3> block_origin(size_t i) const;
   // Extracts block i into `out` (its vectors are reused). Safe to call from several threads.
   void extract(size_t i, SurfaceBlock& out) const;
 

@@ -8,7 +8,10 @@
 #include <array>
 #include <cmath>
 #include <numeric>
+#include <functional>
+#include <limits>
 #include <tuple>
+#include <unordered_map>
 
 #include "errors.h"
 #include "solids/exact.h"
@@ -20,6 +23,7 @@ namespace lacuna {
 namespace {
 
 constexpr uint32_t kNone = UINT32_MAX;
+constexpr int kBlockVoxels = 32;  // the blocks a volume's surface is simplified in
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeviationMargin = 0.75;
 // A triangle's shape: 4 sqrt(3) area over the sum of its squared edges, 1 when equilateral, 0 when
@@ -188,7 +192,16 @@ class CollapseQueue {
 // What one block of the first pass leaves: its vertices (local numbering), the grid-edge key of
 // those on the block's faces, the quadrics of the vertices that moved freely, the volume still
 // owed near each vertex, and its triangles.
+// Where a vertex of a block surface comes in the whole surface's numbering (number_block_vertices):
+// an interior vertex by its block (first) and its place there, then every vertex on a block face
+// by its grid edge's key.
+using VertexOrder = std::pair<uint64_t, uint64_t>;
+// Where a triangle of a block surface comes in the whole surface: its block, then its place there.
+using TriangleOrder = std::pair<uint64_t, uint64_t>;
+constexpr uint64_t kOnBlockFace = uint64_t(1) << 63;
+
 struct BlockResult {
+  int64_t origin_voxels[3] = {0, 0, 0};
   std::vector<Vec3d> positions;
   std::vector<uint64_t> keys;
   std::vector<Quadric> quadrics;
@@ -205,6 +218,8 @@ struct Vertices {
   std::vector<Quadric> quadrics;
   std::vector<uint8_t> has_quadric;
   std::vector<double> debt6;
+  // When not empty: the order a region numbers its vertices in (by these keys, otherwise by index).
+  std::vector<VertexOrder> order;
   explicit Vertices(size_t n) : positions(n), quadrics(n), has_quadric(n, 0), debt6(n, 0.0) {}
 };
 
@@ -243,11 +258,23 @@ class RegionSimplifier {
     global_vertex_.erase(std::unique(global_vertex_.begin(), global_vertex_.end()), global_vertex_.end());
     const size_t nv = global_vertex_.size();
     tri_.resize(nt);
-    for (size_t i = 0; i < nt; ++i)
-      for (int k = 0; k < 3; ++k)
-        tri_[i][size_t(k)] = uint32_t(std::lower_bound(global_vertex_.begin(), global_vertex_.end(),
-                                                       global_tris[tri_ids[i]][size_t(k)]) -
-                                      global_vertex_.begin());
+    if (vertices.order.empty()) {
+      for (size_t i = 0; i < nt; ++i)
+        for (int k = 0; k < 3; ++k)
+          tri_[i][size_t(k)] = uint32_t(std::lower_bound(global_vertex_.begin(), global_vertex_.end(),
+                                                         global_tris[tri_ids[i]][size_t(k)]) -
+                                        global_vertex_.begin());
+    } else {
+      // Numbered as the whole surface numbers them, so the region does what it does there.
+      const std::vector<VertexOrder>& order = vertices.order;
+      auto before = [&](uint32_t a, uint32_t b) { return order[a] < order[b]; };
+      std::sort(global_vertex_.begin(), global_vertex_.end(), before);
+      for (size_t i = 0; i < nt; ++i)
+        for (int k = 0; k < 3; ++k)
+          tri_[i][size_t(k)] = uint32_t(std::lower_bound(global_vertex_.begin(), global_vertex_.end(),
+                                                         global_tris[tri_ids[i]][size_t(k)], before) -
+                                        global_vertex_.begin());
+    }
     pos_.resize(nv);
     quadric_.assign(nv, Quadric());
     own_quadric_.assign(nv, 0);
@@ -1118,16 +1145,52 @@ void simplify_region(RegionSimplifier& simplifier, Load&& load, SimplifyStats& s
   stats.rejected_by_intersection += simplifier.rejected_by_intersection();
 }
 
-// One pass over a global mesh: the regions of side `side` whose grid starts at `origin` (at
-// least a region below the mesh) are simplified independently; a triangle belongs to every
-// region whose open box its box meets, and to the region holding its centroid (which is the one
-// that writes it).
-void simplify_pass(Vertices& vertices, std::vector<std::array<uint32_t, 3>>& triangles, const Vec3d& origin,
-                   double side, const SimplifyOptions& options, SimplifyStats& stats) {
+// The grid of regions a pass simplifies. Either from an origin (a mesh's own box), or the same
+// planes for every surface of a grid: at (m + 1/2) sides for every integer m, so that regions of a
+// block surface hold the meeting points of eight blocks in their middles wherever the surface
+// starts (a surface streamed slab by slab meets the same regions as the whole). Keys order the
+// regions x-major, or z-major (slab by slab, bottom to top).
+struct Lattice {
+  static constexpr double kShift = 1048576.5;  // 2^20 + 1/2: the planes' indices from 0
+  Vec3d origin;
+  double side = 1;
+  bool canonical = false;
+  bool z_major = false;
+  double boundary(int k, int64_t i) const { return canonical ? (double(i) - kShift) * side : origin[k] + double(i) * side; }
+  int64_t index_of(int k, double v) const {
+    return std::max<int64_t>(0, int64_t(std::floor(canonical ? v / side + kShift : (v - origin[k]) / side)));
+  }
+  uint64_t pack(int64_t i, int64_t j, int64_t k) const {
+    return z_major ? (uint64_t(k) << 42) | (uint64_t(j) << 21) | uint64_t(i)
+                   : (uint64_t(i) << 42) | (uint64_t(j) << 21) | uint64_t(k);
+  }
+  void unpack(uint64_t key, int64_t& i, int64_t& j, int64_t& k) const {
+    const int64_t a = int64_t(key >> 42), b = int64_t((key >> 21) & 0x1fffff), c = int64_t(key & 0x1fffff);
+    i = z_major ? c : a;
+    j = b;
+    k = z_major ? a : c;
+  }
+};
+
+// Which regions a pass simplifies and how it reads the triangles' order.
+struct PassScope {
+  // When given: the order the whole surface has its triangles in (a region loads them in it).
+  const std::vector<TriangleOrder>* order = nullptr;
+  // Only the regions whose z index lies in (z_after, z_until].
+  int64_t z_after = -1, z_until = std::numeric_limits<int64_t>::max();
+  bool apply_debt = true;  // add the regions' debt changes to the vertices (a later pass reads them)
+};
+
+// One pass over a global mesh: the regions of the lattice are simplified independently; a
+// triangle belongs to every region whose open box its box meets, and to the region holding its
+// centroid (which is the one that writes it). The regions' triangles, in key order, replace
+// `triangles`, or, when `out` is given, are appended to it and `triangles` stays as it was.
+void simplify_pass(Vertices& vertices, std::vector<std::array<uint32_t, 3>>& triangles, const Lattice& lattice,
+                   const SimplifyOptions& options, SimplifyStats& stats, const PassScope& scope = {},
+                   std::vector<std::array<uint32_t, 3>>* out_triangles = nullptr) {
   const std::vector<Vec3d>& positions = vertices.positions;
-  auto boundary = [&](int k, int64_t i) { return origin[k] + double(i) * side; };
-  auto index_of = [&](int k, double v) { return std::max<int64_t>(0, int64_t(std::floor((v - origin[k]) / side))); };
-  auto pack = [](int64_t i, int64_t j, int64_t k) { return (uint64_t(i) << 42) | (uint64_t(j) << 21) | uint64_t(k); };
+  auto boundary = [&](int k, int64_t i) { return lattice.boundary(k, i); };
+  auto index_of = [&](int k, double v) { return lattice.index_of(k, v); };
   const size_t nt = triangles.size();
   // (region, triangle) pairs, made per block of triangles and concatenated in order.
   const size_t blocks = std::max<size_t>(1, std::min<size_t>(64, nt / 65536 + 1));
@@ -1149,6 +1212,8 @@ void simplify_pass(Vertices& vertices, std::vector<std::array<uint32_t, 3>>& tri
         lo[k] = std::max<int64_t>(0, index_of(k, b.min[k]) - 1);
         hi[k] = index_of(k, b.max[k]) + 1;
       }
+      lo[2] = std::max(lo[2], scope.z_after + 1);
+      hi[2] = std::min(hi[2], scope.z_until);
       bool own_listed = false;
       for (int64_t i = lo[0]; i <= hi[0]; ++i) {
         if (!(b.min.x < boundary(0, i + 1) && b.max.x > boundary(0, i))) continue;
@@ -1156,12 +1221,13 @@ void simplify_pass(Vertices& vertices, std::vector<std::array<uint32_t, 3>>& tri
           if (!(b.min.y < boundary(1, j + 1) && b.max.y > boundary(1, j))) continue;
           for (int64_t k = lo[2]; k <= hi[2]; ++k) {
             if (!(b.min.z < boundary(2, k + 1) && b.max.z > boundary(2, k))) continue;
-            out.push_back({pack(i, j, k), uint32_t(t)});
+            out.push_back({lattice.pack(i, j, k), uint32_t(t)});
             own_listed = own_listed || (i == own[0] && j == own[1] && k == own[2]);
           }
         }
       }
-      if (!own_listed) out.push_back({pack(own[0], own[1], own[2]), uint32_t(t)});
+      if (!own_listed && own[2] > scope.z_after && own[2] <= scope.z_until)
+        out.push_back({lattice.pack(own[0], own[1], own[2]), uint32_t(t)});
     }
   });
   std::vector<std::pair<uint64_t, uint32_t>> members;
@@ -1174,7 +1240,14 @@ void simplify_pass(Vertices& vertices, std::vector<std::array<uint32_t, 3>>& tri
       std::vector<std::pair<uint64_t, uint32_t>>().swap(p);
     }
   }
-  tbb::parallel_sort(members.begin(), members.end());
+  if (scope.order) {
+    const std::vector<TriangleOrder>& order = *scope.order;
+    tbb::parallel_sort(members.begin(), members.end(), [&](const auto& a, const auto& b) {
+      return a.first != b.first ? a.first < b.first : order[a.second] < order[b.second];
+    });
+  } else {
+    tbb::parallel_sort(members.begin(), members.end());
+  }
   std::vector<size_t> region_start;
   for (size_t i = 0; i < members.size(); ++i)
     if (i == 0 || members[i].first != members[i - 1].first) region_start.push_back(i);
@@ -1192,8 +1265,8 @@ void simplify_pass(Vertices& vertices, std::vector<std::array<uint32_t, 3>>& tri
     for (size_t r = range.begin(); r != range.end(); ++r) {
       ids.clear();
       for (size_t i = region_start[r]; i < region_start[r + 1]; ++i) ids.push_back(members[i].second);
-      const uint64_t key = members[region_start[r]].first;
-      const int64_t ri = int64_t(key >> 42), rj = int64_t((key >> 21) & 0x1fffff), rk = int64_t(key & 0x1fffff);
+      int64_t ri, rj, rk;
+      lattice.unpack(members[region_start[r]].first, ri, rj, rk);
       const RegionBox box{{boundary(0, ri), boundary(1, rj), boundary(2, rk)},
                           {boundary(0, ri + 1), boundary(1, rj + 1), boundary(2, rk + 1)}};
       simplify_region(simplifier, [&] { simplifier.load_global(box, triangles, ids, vertices); }, region_stats[r]);
@@ -1201,15 +1274,18 @@ void simplify_pass(Vertices& vertices, std::vector<std::array<uint32_t, 3>>& tri
       progress.advance();
     }
   });
-  triangles.clear();
+  std::vector<std::array<uint32_t, 3>> replaced;
+  std::vector<std::array<uint32_t, 3>>& result = out_triangles ? *out_triangles : replaced;
   for (size_t r = 0; r < regions; ++r) {
-    triangles.insert(triangles.end(), out[r].begin(), out[r].end());
-    for (const auto& [v, change] : debt_changes[r]) vertices.debt6[v] += change;
+    result.insert(result.end(), out[r].begin(), out[r].end());
+    if (scope.apply_debt)
+      for (const auto& [v, change] : debt_changes[r]) vertices.debt6[v] += change;
     stats.collapses += region_stats[r].collapses;
     stats.rejected_by_intersection += region_stats[r].rejected_by_intersection;
     stats.regions_redone += region_stats[r].regions_redone;
     ++stats.regions;
   }
+  if (!out_triangles) triangles.swap(replaced);
 }
 
 // The vertices the triangles use, renumbered in their order, and the triangles.
@@ -1263,23 +1339,25 @@ TriMesh simplify_mesh(const TriMesh& mesh, const SimplifyOptions& options, Simpl
     side = std::clamp(std::sqrt(20000.0 * area / double(triangles.size())), extent / 64, std::max(extent / 2, 1e-9));
     if (!(side > 0)) side = 1;
   }
-  const Vec3d origin = box.min - Vec3d{side, side, side} * 1.25;
-  simplify_pass(vertices, triangles, origin, side, options, stats);
-  simplify_pass(vertices, triangles, origin - Vec3d{side, side, side} * 0.5, side, options, stats);
+  Lattice lattice;
+  lattice.origin = box.min - Vec3d{side, side, side} * 1.25;
+  lattice.side = side;
+  simplify_pass(vertices, triangles, lattice, options, stats);
+  lattice.origin = lattice.origin - Vec3d{side, side, side} * 0.5;
+  simplify_pass(vertices, triangles, lattice, options, stats);
   TriMesh out = compact(positions, triangles);
   stats.output_triangles = out.triangles.size();
   if (stats_out) *stats_out = stats;
   return out;
 }
 
-TriMesh extract_simplified_surface(const Volume& volume, const SimplifyOptions& options, SimplifyStats* stats_out) {
-  check_options(options);
-  SimplifyStats stats;
-  constexpr int kBlockVoxels = 32;
-  ExtractOptions extract;
-  extract.merge_deviation_mm = options.merge_fraction * options.max_deviation_mm;
-  const BlockExtractor extractor(volume, kBlockVoxels, extract);
-  const size_t blocks = extractor.block_count();
+namespace {
+
+// Extracts the blocks `which` of the extractor (its indices, in increasing order) and simplifies
+// each within its own box: results[i] for which[i]. Adds their figures to `stats`.
+std::vector<BlockResult> simplified_blocks(const BlockExtractor& extractor, const std::vector<size_t>& which,
+                                           const SimplifyOptions& options, SimplifyStats& stats) {
+  const size_t blocks = which.size();
   std::vector<BlockResult> results(blocks);
   std::vector<SimplifyStats> block_stats(blocks);
   {
@@ -1290,13 +1368,14 @@ TriMesh extract_simplified_surface(const Volume& volume, const SimplifyOptions& 
       RegionSimplifier& simplifier = simplifiers.local();
       SurfaceBlock& block = surface_blocks.local();
       for (size_t i = range.begin(); i != range.end(); ++i) {
-        extractor.extract(i, block);
+        extractor.extract(which[i], block);
         block_stats[i].input_triangles = block.piece_triangles;
         block_stats[i].merged_triangles = block.triangles.size();
         if (!block.triangles.empty()) {
           simplify_region(simplifier, [&] { simplifier.load_block(block); }, block_stats[i]);
           simplifier.store_block(block, results[i]);
         }
+        for (int k = 0; k < 3; ++k) results[i].origin_voxels[k] = block.origin_voxels[k];
         progress.advance();
       }
     });
@@ -1309,6 +1388,39 @@ TriMesh extract_simplified_surface(const Volume& volume, const SimplifyOptions& 
     stats.regions_redone += block_stats[i].regions_redone;
     stats.regions += results[i].triangles.empty() ? 0 : 1;
   }
+  return results;
+}
+
+// The regions of a block surface: one block wide, centred on the blocks' meeting points.
+Lattice block_lattice(double voxel_size_mm) {
+  Lattice lattice;
+  lattice.side = kBlockVoxels * voxel_size_mm;
+  lattice.canonical = true;
+  lattice.z_major = true;
+  return lattice;
+}
+
+// The regions' indices hold 21 bits: a surface within 2^19 blocks of the origin.
+void check_lattice_reach(const Box3& box, double voxel_size_mm) {
+  const double reach = double(1 << 19) * kBlockVoxels * voxel_size_mm;
+  for (int k = 0; k < 3; ++k)
+    if (!(box.min[k] > -reach && box.max[k] < reach))
+      throw ResourceLimit("the surface reaches beyond " + std::to_string(1 << 19) +
+                          " blocks of 32 voxels from the origin; move the part nearer the origin");
+}
+
+}  // namespace
+
+TriMesh extract_simplified_surface(const Volume& volume, const SimplifyOptions& options, SimplifyStats* stats_out) {
+  check_options(options);
+  SimplifyStats stats;
+  ExtractOptions extract;
+  extract.merge_deviation_mm = options.merge_fraction * options.max_deviation_mm;
+  const BlockExtractor extractor(volume, kBlockVoxels, extract);
+  const size_t blocks = extractor.block_count();
+  std::vector<size_t> all(blocks);
+  std::iota(all.begin(), all.end(), size_t(0));
+  std::vector<BlockResult> results = simplified_blocks(extractor, all, options, stats);
   std::vector<const std::vector<uint64_t>*> keys(blocks);
   for (size_t i = 0; i < blocks; ++i) keys[i] = &results[i].keys;
   std::vector<std::vector<uint32_t>> global;
@@ -1349,17 +1461,239 @@ TriMesh extract_simplified_surface(const Volume& volume, const SimplifyOptions& 
   // Across the block faces: regions of the same size, shifted by half a block, so each holds a
   // meeting point of eight blocks in its middle.
   if (!triangles.empty()) {
-    const double side = kBlockVoxels * volume.voxel_size_mm();
     Box3 box;
     for (const Vec3d& p : positions) box.expand(p);
-    Vec3d origin;
-    for (int k = 0; k < 3; ++k) origin[k] = (std::floor(box.min[k] / side) - 1.5) * side;
-    simplify_pass(vertices, triangles, origin, side, options, stats);
+    check_lattice_reach(box, volume.voxel_size_mm());
+    simplify_pass(vertices, triangles, block_lattice(volume.voxel_size_mm()), options, stats);
   }
   TriMesh out = compact(positions, triangles);
   stats.output_triangles = out.triangles.size();
   if (stats_out) *stats_out = stats;
   return out;
 }
+
+
+// The stream keeps a window of the surface: the simplified blocks of the slabs added so far whose
+// triangles a region not simplified yet still meets, with what the whole surface's pass would know
+// of their vertices (positions, quadrics, debts, their place in its numbering). A region runs once
+// every block it meets is in and every vertex it loads has its debt summed from all its blocks:
+// after a slab ending at z1, the regions whose top lies 1.5 blocks below z1 (their triangles come
+// from blocks ending at z1 - 1 block at most, whose vertices lie below z1). Regions run as they do
+// in one pass (none reads what another wrote: a triangle two regions meet has its vertices locked
+// in both), so their triangles are the whole pass's, emitted in its order.
+struct StreamedSurface::Impl {
+  SimplifyOptions options;
+  double h = 0;
+  Lattice lattice;
+  std::function<void(const EmittedTriangles&)> emit;
+  Vertices window{0};
+  std::vector<uint64_t> numbers;  // per window vertex: its number in the stream
+  std::vector<std::array<uint32_t, 3>> triangles;
+  std::vector<TriangleOrder> triangle_order;
+  std::unordered_map<uint64_t, uint32_t> on_face;  // grid edge key -> window vertex
+  // Face vertices whose blocks are not all in: (block, debt) per block so far.
+  std::unordered_map<uint64_t, std::vector<std::pair<uint64_t, double>>> unsettled;
+  int64_t regions_done = -1;                  // regions with z index up to this have run
+  int64_t z_end = std::numeric_limits<int64_t>::min();  // the voxels added so far end here
+  uint64_t next_number = 0;
+  SimplifyStats stats;
+  bool finished = false;
+
+  static uint64_t block_key(const int64_t o[3]) {
+    uint64_t key = 0;
+    for (int k = 0; k < 3; ++k) {
+      const int64_t b = o[k] / kBlockVoxels + (int64_t(1) << 19);
+      if (o[k] % kBlockVoxels != 0 || b < 0 || b >= (int64_t(1) << 20))
+        throw ResourceLimit("the surface reaches beyond " + std::to_string(1 << 19) +
+                            " blocks of 32 voxels from the origin; move the part nearer the origin");
+      key = (key << 20) | uint64_t(b);
+    }
+    return key;  // x-major, as the blocks come in the whole surface
+  }
+
+  uint32_t new_vertex(const Vec3d& p, const VertexOrder& order) {
+    window.positions.push_back(p);
+    window.quadrics.push_back(Quadric());
+    window.has_quadric.push_back(0);
+    window.debt6.push_back(0.0);
+    window.order.push_back(order);
+    numbers.push_back(next_number++);
+    return uint32_t(window.positions.size() - 1);
+  }
+
+  void add_blocks(std::vector<BlockResult>& results) {
+    for (BlockResult& r : results) {
+      if (r.triangles.empty()) continue;
+      const uint64_t bk = block_key(r.origin_voxels);
+      std::vector<uint32_t> local(r.positions.size());
+      for (size_t v = 0; v < r.positions.size(); ++v) {
+        if (r.keys[v] == kInteriorVertex) {
+          const uint32_t w = local[v] = new_vertex(r.positions[v], {bk, v});
+          window.quadrics[w] = r.quadrics[v];
+          window.has_quadric[w] = r.has_quadric[v];
+          window.debt6[w] = r.debt6[v];
+        } else {
+          auto [it, inserted] = on_face.try_emplace(r.keys[v], 0u);
+          if (inserted) it->second = new_vertex(r.positions[v], {kOnBlockFace, r.keys[v]});
+          local[v] = it->second;
+          unsettled[r.keys[v]].push_back({bk, r.debt6[v]});
+        }
+      }
+      for (size_t t = 0; t < r.triangles.size(); ++t) {
+        const auto& tri = r.triangles[t];
+        triangles.push_back({local[tri[0]], local[tri[1]], local[tri[2]]});
+        triangle_order.push_back({bk, t});
+      }
+      r = BlockResult();
+    }
+  }
+
+  // The face vertices below z_mm have every block in: their debts summed in the blocks' order.
+  void settle(double z_mm) {
+    for (auto it = unsettled.begin(); it != unsettled.end();) {
+      const uint32_t w = on_face.at(it->first);
+      if (!(window.positions[w].z < z_mm)) {
+        ++it;
+        continue;
+      }
+      std::sort(it->second.begin(), it->second.end());
+      double debt = 0;
+      for (const auto& [block, share] : it->second) debt += share;
+      window.debt6[w] = debt;
+      it = unsettled.erase(it);
+    }
+  }
+
+  // Runs the regions up to z index `until`, emits their triangles and keeps what later regions meet.
+  void run_regions(int64_t until) {
+    if (until <= regions_done) return;
+    std::vector<std::array<uint32_t, 3>> out;
+    if (!triangles.empty()) {
+      PassScope scope;
+      scope.order = &triangle_order;
+      scope.z_after = regions_done;
+      scope.z_until = until;
+      scope.apply_debt = false;  // the stream's pass is the last: nothing reads the debts after it
+      Box3 box;
+      for (const Vec3d& p : window.positions) box.expand(p);
+      check_lattice_reach(box, h);
+      simplify_pass(window, triangles, lattice, options, stats, scope, &out);
+    }
+    regions_done = until;
+    if (!out.empty()) {
+      EmittedTriangles batch;
+      batch.corners.reserve(out.size());
+      batch.numbers.reserve(out.size());
+      for (const auto& t : out) {
+        batch.corners.push_back({window.positions[t[0]], window.positions[t[1]], window.positions[t[2]]});
+        batch.numbers.push_back({numbers[t[0]], numbers[t[1]], numbers[t[2]]});
+      }
+      stats.output_triangles += out.size();
+      emit(batch);
+    }
+    // Keep the triangles a later region meets (its open box, or its half-open box holding the centroid).
+    const double top = lattice.boundary(2, until + 1);
+    size_t kept = 0;
+    for (size_t t = 0; t < triangles.size(); ++t) {
+      const auto& tri = triangles[t];
+      const Vec3d &p0 = window.positions[tri[0]], &p1 = window.positions[tri[1]], &p2 = window.positions[tri[2]];
+      const double centroid_z = (p0.z + p1.z + p2.z) / 3.0;
+      if (std::max({p0.z, p1.z, p2.z}) > top || centroid_z >= top) {
+        triangles[kept] = triangles[t];
+        triangle_order[kept] = triangle_order[t];
+        ++kept;
+      }
+    }
+    triangles.resize(kept);
+    triangle_order.resize(kept);
+    // The vertices they use, renumbered in window order.
+    std::vector<uint32_t> index(window.positions.size(), kNone);
+    for (const auto& t : triangles)
+      for (uint32_t v : t) index[v] = 0;
+    uint32_t n = 0;
+    for (size_t v = 0; v < index.size(); ++v) {
+      if (index[v] == kNone) continue;
+      index[v] = n;
+      window.positions[n] = window.positions[v];
+      window.quadrics[n] = window.quadrics[v];
+      window.has_quadric[n] = window.has_quadric[v];
+      window.debt6[n] = window.debt6[v];
+      window.order[n] = window.order[v];
+      numbers[n] = numbers[v];
+      ++n;
+    }
+    window.positions.resize(n);
+    window.quadrics.resize(n);
+    window.has_quadric.resize(n);
+    window.debt6.resize(n);
+    window.order.resize(n);
+    numbers.resize(n);
+    for (auto& t : triangles)
+      for (uint32_t& v : t) v = index[v];
+    for (auto it = on_face.begin(); it != on_face.end();) {
+      if (index[it->second] == kNone) {
+        unsettled.erase(it->first);
+        it = on_face.erase(it);
+      } else {
+        it->second = index[it->second];
+        ++it;
+      }
+    }
+  }
+};
+
+StreamedSurface::StreamedSurface(const SimplifyOptions& options, double voxel_size_mm,
+                                 std::function<void(const EmittedTriangles&)> emit)
+    : impl_(std::make_unique<Impl>()) {
+  check_options(options);
+  if (!(voxel_size_mm > 0)) throw InvalidInput("a streamed surface needs a positive voxel size");
+  impl_->options = options;
+  impl_->h = voxel_size_mm;
+  impl_->lattice = block_lattice(voxel_size_mm);
+  impl_->emit = std::move(emit);
+}
+
+StreamedSurface::~StreamedSurface() = default;
+
+void StreamedSurface::add(const Volume& volume, int64_t z0_voxels, int64_t z1_voxels) {
+  Impl& m = *impl_;
+  if (m.finished) throw InternalError("StreamedSurface::add after finish");
+  if (z1_voxels <= z0_voxels || (z0_voxels != m.z_end && m.z_end != std::numeric_limits<int64_t>::min()) ||
+      (z1_voxels != kUnbounded && z1_voxels % kBlockVoxels != 0) ||
+      (z0_voxels != kUnbounded && z0_voxels != -kUnbounded && z0_voxels % kBlockVoxels != 0))
+    throw InternalError("StreamedSurface::add: slabs must follow each other on whole blocks of 32 voxels");
+  if (!volume.empty() && std::fabs(volume.voxel_size_mm() - m.h) > 1e-12 * m.h)
+    throw InternalError("StreamedSurface::add: a slab of another voxel size");
+  m.z_end = z1_voxels;
+  if (!volume.empty()) {
+    ExtractOptions extract;
+    extract.merge_deviation_mm = m.options.merge_fraction * m.options.max_deviation_mm;
+    const BlockExtractor extractor(volume, kBlockVoxels, extract);
+    std::vector<size_t> which;
+    for (size_t i = 0; i < extractor.block_count(); ++i) {
+      const int64_t z = extractor.block_origin(i)[2];
+      if (z >= z0_voxels && z < z1_voxels) which.push_back(i);
+    }
+    std::vector<BlockResult> results = simplified_blocks(extractor, which, m.options, m.stats);
+    m.add_blocks(results);
+  }
+  if (z1_voxels == kUnbounded) return;
+  const double z1_mm = double(z1_voxels) * m.h;
+  m.settle(z1_mm - 0.001 * m.h);
+  // The regions whose top lies 1.5 blocks below z1: (k + 1 - kShift) side <= z1 - 1.5 side.
+  const int64_t c = z1_voxels / kBlockVoxels;
+  m.run_regions(c + (int64_t(1) << 20) - 2);
+}
+
+void StreamedSurface::finish() {
+  Impl& m = *impl_;
+  if (m.finished) return;
+  m.settle(std::numeric_limits<double>::infinity());
+  m.run_regions((int64_t(1) << 21) - 1);
+  m.finished = true;
+}
+
+const SimplifyStats& StreamedSurface::stats() const { return impl_->stats; }
+uint64_t StreamedSurface::numbers_given() const { return impl_->next_number; }
 
 }  // namespace lacuna

@@ -5,7 +5,12 @@
 // identical output for any number of threads.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <functional>
+#include <limits>
+#include <memory>
+#include <vector>
 
 #include "geometry.h"
 #include "solids/volume.h"
@@ -46,5 +51,41 @@ TriMesh simplify_mesh(const TriMesh& mesh, const SimplifyOptions& options, Simpl
 // guarantees as simplify_mesh.
 TriMesh extract_simplified_surface(const Volume& volume, const SimplifyOptions& options,
                                    SimplifyStats* stats = nullptr);
+
+// Final triangles of a streamed surface, with a number per vertex: the same number wherever the
+// vertex appears, distinct vertices distinct numbers (from 0, in the order they first came in).
+struct EmittedTriangles {
+  std::vector<std::array<Vec3d, 3>> corners;  // float32 values, counter-clockwise seen from outside
+  std::vector<std::array<uint64_t, 3>> numbers;
+};
+
+// extract_simplified_surface of a volume that comes slab by slab, bottom to top: each slab's
+// blocks are simplified as they come, the pass across the blocks' faces runs region by region as
+// the blocks it meets are in, and the final triangles go to `emit` as they are made, so memory
+// holds a slab and the regions around its cuts. The triangles, in the order emitted, are the
+// whole volume's extract_simplified_surface, triangle for triangle (before its vertices are
+// renumbered), when every slab's volume equals the whole one over its blocks and a voxel above.
+class StreamedSurface {
+ public:
+  static constexpr int kSlabVoxels = 32;  // slabs start and end on whole blocks of this many voxels
+  static constexpr int64_t kUnbounded = std::numeric_limits<int64_t>::max();
+  StreamedSurface(const SimplifyOptions& options, double voxel_size_mm,
+                  std::function<void(const EmittedTriangles&)> emit);
+  ~StreamedSurface();
+  StreamedSurface(const StreamedSurface&) = delete;
+  StreamedSurface& operator=(const StreamedSurface&) = delete;
+
+  // Adds the surface blocks of `volume` whose lowest voxel z index lies in [z0, z1): the first
+  // slab from -kUnbounded, each next one from where the last ended, the last to kUnbounded.
+  void add(const Volume& volume, int64_t z0_voxels, int64_t z1_voxels);
+  // Emits what is left (after the last slab).
+  void finish();
+  const SimplifyStats& stats() const;
+  uint64_t numbers_given() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace lacuna

@@ -17,7 +17,10 @@
 #include <sstream>
 
 #include "errors.h"
+#include "export/mesh_io.h"
 #include "pipeline/slice_output.h"
+#include "pipeline/stream_output.h"
+#include "solids/check.h"
 #include "tests/test_support.h"
 
 namespace lacuna {
@@ -452,6 +455,127 @@ TEST(Slice, SlabBySlabGivesTheWholeRunsBytes) {
       EXPECT_EQ(test::read_file(dir / ("whole-" + std::string(name))), test::read_file(dir / ("slabs-" + std::string(name))));
     }
   }
+}
+
+// The recipe with one STL output of `object` and nothing a streamed run refuses.
+Recipe one_stl(const std::string& path, const std::string& object, double voxel_mm) {
+  Recipe recipe = load_recipe(path);
+  if (voxel_mm > 0) recipe.voxel_size_mm = voxel_mm;
+  RecipeOutput out;
+  out.object = object;
+  out.file = object + ".stl";
+  out.format = "stl";
+  out.part_name = object;
+  out.json_path = "outputs[0]";
+  recipe.outputs = {out};
+  recipe.printability = PrintabilitySettings{};
+  return recipe;
+}
+
+TEST(Stream, MeshSlabBySlabIsTheWholeRunsFile) {
+  TempDir dir;
+  struct Case {
+    std::string recipe, object;
+    double voxel_mm, slab_mm;
+  };
+  const std::string source = LACUNA_SOURCE_DIR;
+  const Case cases[] = {
+      {operations_recipe(dir), "walls", 0, 1.6},
+      {operations_recipe(dir), "cut", 0, 3.2},
+      {source + "/samples/egg_infill.json", "part", 0.3, 9.6},
+      {source + "/samples/menger_sponge.json", "sponge", 1.0 / 9, 2.0},
+  };
+  for (size_t i = 0; i < std::size(cases); ++i) {
+    const Case& c = cases[i];
+    SCOPED_TRACE(c.recipe + " " + c.object);
+    const Recipe recipe = one_stl(c.recipe, c.object, c.voxel_mm);
+    RunOptions whole_options;
+    whole_options.output_dir = (dir / ("whole-" + std::to_string(i))).string();
+    whole_options.write_report = false;
+    const RunReport whole = run(recipe, whole_options);
+    ASSERT_TRUE(whole.valid);
+    StreamOptions options;
+    options.run.output_dir = (dir / ("stream-" + std::to_string(i))).string();
+    options.slab_mm = c.slab_mm;
+    const StreamReport streamed = stream_recipe(recipe, options);
+    ASSERT_TRUE(streamed.valid);
+    ASSERT_EQ(streamed.outputs.size(), 1u);
+    const StreamedOutput& o = streamed.outputs[0];
+    EXPECT_GE(o.slabs, 2u);
+    // Chunks start where every triangle to come lies above the one before the last.
+    EXPECT_GE(o.check_chunks, i == 3 ? 2u : 1u);
+    EXPECT_GT(o.halo_mm, 0);
+    const std::string name = c.object + ".stl";
+    const std::string bytes = test::read_file(fs::path(whole_options.output_dir) / name);
+    EXPECT_TRUE(bytes == test::read_file(fs::path(options.run.output_dir) / name)) << "the files differ";
+    // The chunked check's figures are the whole file's.
+    const MeshCheckReport check = check_mesh(read_mesh((fs::path(options.run.output_dir) / name).string()));
+    EXPECT_EQ(o.check.triangles, check.triangles);
+    EXPECT_EQ(o.check.vertices, check.vertices);
+    EXPECT_EQ(o.check.components, check.components);
+    EXPECT_EQ(o.check.genus, check.genus);
+    EXPECT_NEAR(o.check.volume_mm3, check.volume_mm3, 1e-9 * check.volume_mm3);
+    EXPECT_TRUE(o.check.valid()) << ::testing::PrintToString(o.check.problems());
+    EXPECT_EQ(o.triangles, whole.outputs.at(0).check->triangles);
+    EXPECT_TRUE(fs::exists(fs::path(options.run.output_dir) / "report.json"));
+  }
+}
+
+TEST(Stream, TheBudgetPicksTheSlabsAndWhatItCannotStreamIsRefused) {
+  TempDir dir;
+  const std::string recipe_path = std::string(LACUNA_SOURCE_DIR) + "/samples/menger_sponge.json";
+  const Recipe recipe = one_stl(recipe_path, "sponge", 1.0 / 9);
+  StreamOptions options;
+  options.run.output_dir = (dir / "whole").string();
+  const StreamReport whole = stream_recipe(recipe, options);
+  ASSERT_TRUE(whole.valid);
+  EXPECT_EQ(whole.outputs.at(0).slabs, 1u);
+  EXPECT_EQ(whole.outputs.at(0).check_chunks, 1u);
+  options.run.output_dir = (dir / "slabs").string();
+  options.run.max_memory_bytes = whole.outputs.at(0).memory_estimate_bytes / 2;
+  const StreamReport slabs = stream_recipe(recipe, options);
+  ASSERT_TRUE(slabs.valid);
+  EXPECT_GE(slabs.outputs.at(0).slabs, 2u);
+  EXPECT_LE(slabs.outputs.at(0).memory_estimate_bytes, options.run.max_memory_bytes);
+  EXPECT_TRUE(test::read_file(dir / "whole" / "sponge.stl") == test::read_file(dir / "slabs" / "sponge.stl"));
+  // Refused by name, before anything is made: other formats, printability, no simplification.
+  auto refusal = [&](Recipe r, const std::string& expected) {
+    StreamOptions o;
+    o.run.output_dir = (dir / "refused").string();
+    try {
+      stream_recipe(r, o);
+      ADD_FAILURE() << "expected a refusal naming " << expected;
+    } catch (const InvalidInput& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(fs::exists(dir / "refused"));
+  };
+  Recipe three_mf = load_recipe(recipe_path);
+  refusal(three_mf, "outputs[1] (menger_sponge.3mf): a streamed run writes STL meshes");
+  Recipe printability = recipe;
+  printability.printability.enabled = true;
+  refusal(printability, "printability: a streamed run does not analyse printability");
+  Recipe plain = recipe;
+  plain.simplify_mm = 0;
+  refusal(plain, "outputs[0]: a streamed mesh is simplified as it is made");
+  // From the command line: --slab-mm alone is refused; --stream writes the file and its report.
+  const std::string fixed = (dir / "sponge.json").string();
+  nlohmann::json j = nlohmann::json::parse(test::read_file(recipe_path));
+  j["outputs"] = nlohmann::json::array({j["outputs"][0]});
+  test::write_file(fixed, j.dump());
+  const test::Result alone = test::lacuna("run " + test::quote(fixed) + " -o " + test::quote((dir / "cli").string()) +
+                                              " --slab-mm 4", dir.path());
+  EXPECT_EQ(alone.code, 2) << alone.err;
+  EXPECT_NE(alone.err.find("--slab-mm: needs --stream"), std::string::npos) << alone.err;
+  const test::Result cli = test::lacuna("run " + test::quote(fixed) + " -o " + test::quote((dir / "cli").string()) +
+                                            " --stream --slab-mm 4 --json", dir.path());
+  ASSERT_EQ(cli.code, 0) << cli.err;
+  const nlohmann::json report = nlohmann::json::parse(cli.out);
+  EXPECT_TRUE(report["valid"].get<bool>());
+  EXPECT_GE(report["outputs"][0]["slabs"].get<int>(), 3);
+  EXPECT_TRUE(report["outputs"][0]["checks"]["valid"].get<bool>());
+  const test::Result check = test::lacuna("check " + test::quote((dir / "cli" / "menger_sponge.stl").string()), dir.path());
+  EXPECT_EQ(check.code, 0) << check.out << check.err;
 }
 
 TEST(Slice, TheBudgetPicksTheSlabsAndNothingIsLeftBehind) {

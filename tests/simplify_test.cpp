@@ -5,6 +5,8 @@
 #include <tbb/global_control.h>
 
 #include <cmath>
+#include <map>
+#include <set>
 
 #include "cifs/library.h"
 #include "cifs/solid_input.h"
@@ -211,6 +213,155 @@ TEST(Simplify, SameResultForAnyThreadCount) {
   EXPECT_EQ(one.triangles, two.triangles);
   ASSERT_EQ(one.positions_mm.size(), two.positions_mm.size());
   for (size_t i = 0; i < one.positions_mm.size(); ++i) ASSERT_EQ(one.positions_mm[i], two.positions_mm[i]) << i;
+}
+
+// The surface streamed slab by slab (slabs of `slab_voxels`, cut from the same volume) as one
+// list of triangles and the vertex numbers the stream gave them.
+struct Streamed {
+  std::vector<std::array<Vec3d, 3>> corners;
+  std::vector<std::array<uint64_t, 3>> numbers;
+  size_t batches = 0;
+};
+Streamed stream(const Volume& volume, const SimplifyOptions& options, int slab_voxels, const Box3& box) {
+  Streamed out;
+  StreamedSurface surface(options, volume.voxel_size_mm(), [&](const EmittedTriangles& batch) {
+    out.corners.insert(out.corners.end(), batch.corners.begin(), batch.corners.end());
+    out.numbers.insert(out.numbers.end(), batch.numbers.begin(), batch.numbers.end());
+    ++out.batches;
+  });
+  const double h = volume.voxel_size_mm();
+  int64_t z = int64_t(std::floor(box.min.z / h / 32) - 1) * 32, z0 = -StreamedSurface::kUnbounded;
+  for (; double(z) * h < box.max.z; z += slab_voxels) {
+    surface.add(volume, z0, z + slab_voxels);
+    z0 = z + slab_voxels;
+  }
+  surface.add(volume, z0, StreamedSurface::kUnbounded);
+  surface.finish();
+  return out;
+}
+
+TEST(Simplify, StreamedSlabBySlabIsTheWholeSurface) {
+  GeometrySet set = sphere({0.1, 0.2, 0.3}, 3);
+  set.tubes.tubes.push_back(Tube{{{-4, 0, -6}, {4, 1, 0.5}, {4, 4, 6}}, {0.7}});
+  const double h = 1.0 / 9.0;
+  nlohmann::json spec = {{"library", "menger_sponge"}, {"scale", 9.0}, {"translate_mm", {h / 2, h / 2, 8.0}}};
+  GeometrySet menger = cifs::attractor_geometry(cifs::parse_system(spec, "test", "system"), 2, {});
+  for (const auto& [what, volume] : {std::pair<std::string, Volume>{"sphere and tube", voxelize(set, VolumeOptions{0.08, 3.0})},
+                                     {"Menger sponge", voxelize(menger, VolumeOptions{h, 3.0})}}) {
+    SimplifyOptions options;
+    options.max_deviation_mm = 0.2 * volume.voxel_size_mm();
+    const TriMesh whole = extract_simplified_surface(volume, options);
+    ASSERT_TRUE(check_mesh(whole).valid()) << what;
+    for (int slab : {32, 64, 96}) {
+      Box3 box;
+      for (const Vec3d& p : whole.positions_mm) box.expand(p);
+      const Streamed s = stream(volume, options, slab, box);
+      // Slabs of 32 voxels emit once per slab past the first two, 1.5 blocks behind the cut.
+      EXPECT_GE(double(s.batches), (box.size().z / volume.voxel_size_mm() - 48) / slab) << what << ", slabs of " << slab;
+      EXPECT_GE(s.batches, 2u) << what << ", slabs of " << slab;
+      ASSERT_EQ(s.corners.size(), whole.triangles.size()) << what << ", slabs of " << slab;
+      size_t differ = 0;
+      std::map<std::array<double, 3>, uint64_t> number_of;
+      size_t inconsistent = 0;
+      for (size_t t = 0; t < whole.triangles.size(); ++t)
+        for (int k = 0; k < 3; ++k) {
+          const Vec3d& p = whole.positions_mm[whole.triangles[t][size_t(k)]];
+          differ += !(s.corners[t][size_t(k)] == p);
+          auto [it, inserted] = number_of.try_emplace({p.x, p.y, p.z}, s.numbers[t][size_t(k)]);
+          inconsistent += !inserted && it->second != s.numbers[t][size_t(k)];
+        }
+      EXPECT_EQ(differ, 0u) << what << ", slabs of " << slab;
+      EXPECT_EQ(inconsistent, 0u) << what << ", slabs of " << slab;
+      std::set<uint64_t> numbers;
+      for (const auto& n : s.numbers) numbers.insert(n.begin(), n.end());
+      EXPECT_EQ(numbers.size(), number_of.size()) << what << ": one number per vertex";
+    }
+  }
+}
+
+// The mesh's triangles in bands of `height` mm by their centroids' z, each band in mesh order.
+std::vector<std::vector<std::array<Vec3d, 3>>> z_bands(const TriMesh& mesh, double height) {
+  std::map<int64_t, std::vector<std::array<Vec3d, 3>>> bands;
+  for (const auto& t : mesh.triangles) {
+    const std::array<Vec3d, 3> c{mesh.positions_mm[t[0]], mesh.positions_mm[t[1]], mesh.positions_mm[t[2]]};
+    bands[int64_t(std::floor((c[0].z + c[1].z + c[2].z) / 3 / height))].push_back(c);
+  }
+  std::vector<std::vector<std::array<Vec3d, 3>>> out;
+  for (auto& [k, band] : bands) out.push_back(std::move(band));
+  return out;
+}
+
+MeshCheckReport chunked_check(const TriMesh& mesh, double height) {
+  ChunkedCheck check;
+  auto bands = z_bands(mesh, height);
+  for (size_t i = 0; i < bands.size(); ++i) check.add(std::move(bands[i]), i + 1 == bands.size());
+  return check.finish();
+}
+
+void expect_same_report(const MeshCheckReport& a, const MeshCheckReport& b, const std::string& what) {
+  EXPECT_EQ(a.valid(), b.valid()) << what << ": " << ::testing::PrintToString(a.problems());
+  EXPECT_EQ(a.problems(), b.problems()) << what;
+  EXPECT_EQ(a.triangles, b.triangles) << what;
+  EXPECT_EQ(a.vertices, b.vertices) << what;
+  EXPECT_EQ(a.edges, b.edges) << what;
+  EXPECT_EQ(a.boundary_edges, b.boundary_edges) << what;
+  EXPECT_EQ(a.components, b.components) << what;
+  EXPECT_EQ(a.genus, b.genus) << what;
+  EXPECT_EQ(a.inward_components, b.inward_components) << what;
+  EXPECT_EQ(a.self_intersecting, b.self_intersecting) << what;
+  if (b.closed()) {
+    EXPECT_NEAR(a.volume_mm3, b.volume_mm3, 1e-9 * std::fabs(b.volume_mm3) + 1e-9) << what;
+  }
+  EXPECT_NEAR(a.area_mm2, b.area_mm2, 1e-9 * b.area_mm2) << what;
+}
+
+TEST(Simplify, ChunkedCheckReadsAsTheWholeCheck) {
+  GeometrySet set = sphere({0.1, 0.2, 0.3}, 3);
+  set.tubes.tubes.push_back(Tube{{{-4, 0, -6}, {4, 1, 0.5}, {4, 4, 6}}, {0.7}});
+  SimplifyOptions options;
+  options.max_deviation_mm = 0.016;
+  const TriMesh part = extract_simplified_surface(voxelize(set, VolumeOptions{0.08, 3.0}), options);
+  const double h = 1.0 / 9.0;
+  nlohmann::json spec = {{"library", "menger_sponge"}, {"scale", 9.0}, {"translate_mm", {h / 2, h / 2, 8.0}}};
+  options.max_deviation_mm = 0.2 * h;
+  const TriMesh menger = extract_simplified_surface(
+      voxelize(cifs::attractor_geometry(cifs::parse_system(spec, "test", "system"), 2, {}), VolumeOptions{h, 3.0}), options);
+  // A hollow ball: the inner shell turned inward bounds a cavity.
+  options.max_deviation_mm = 0.016;
+  TriMesh hollow = extract_simplified_surface(voxelize(sphere({0, 0, 0}, 5), VolumeOptions{0.08, 3.0}), options);
+  TriMesh inner = extract_simplified_surface(voxelize(sphere({0.3, 0, 0.2}, 3), VolumeOptions{0.08, 3.0}), options);
+  auto append = [](TriMesh& to, const TriMesh& from, bool flip) {
+    const uint32_t base = uint32_t(to.positions_mm.size());
+    to.positions_mm.insert(to.positions_mm.end(), from.positions_mm.begin(), from.positions_mm.end());
+    for (auto t : from.triangles) {
+      if (flip) std::swap(t[1], t[2]);
+      to.triangles.push_back({base + t[0], base + t[1], base + t[2]});
+    }
+  };
+  TriMesh with_cavity = hollow, inward = hollow, open = part, overlapping = hollow;
+  append(with_cavity, inner, true);
+  append(inward, inner, false);
+  open.triangles.erase(open.triangles.begin() + long(open.triangles.size() / 2));
+  TriMesh shifted = inner;
+  for (Vec3d& p : shifted.positions_mm) p.x += 4.5;  // crosses the outer shell
+  append(overlapping, shifted, false);
+  for (const auto& [what, mesh] : {std::pair<std::string, const TriMesh*>{"sphere and tube", &part}, {"Menger sponge", &menger},
+                                   {"hollow ball", &with_cavity}, {"inner shell outward", &inward},
+                                   {"a triangle missing", &open}, {"overlapping shells", &overlapping}}) {
+    const MeshCheckReport whole = check_mesh(*mesh);
+    for (double height : {4.0, 6.0, 100.0}) {
+      const MeshCheckReport chunked = chunked_check(*mesh, height);
+      EXPECT_TRUE(chunked.self_intersections_checked || !whole.self_intersections_checked) << what << ", " << height;
+      expect_same_report(chunked, whole, what + ", bands of " + std::to_string(height) + " mm");
+    }
+  }
+  EXPECT_TRUE(check_mesh(part).valid());
+  EXPECT_TRUE(check_mesh(with_cavity).valid());
+  EXPECT_EQ(check_mesh(inward).inward_components, 1u);
+  EXPECT_EQ(check_mesh(open).boundary_edges, 3u);
+  EXPECT_TRUE(check_mesh(overlapping).self_intersecting);
+  // Bands thinner than the triangles: two chunks apart may touch, so the check says it could not test.
+  EXPECT_FALSE(chunked_check(menger, 0.3).self_intersections_checked);
 }
 
 TEST(Simplify, AnyClosedMeshAndItsBoundaryKept) {

@@ -22,6 +22,7 @@
 #include "cli/exit_codes.h"
 #include "cli/fill_commands.h"
 #include "cli/mpi_ranks.h"
+#include "pipeline/stream_output.h"
 #include "cli/number_checks.h"
 #include "cli/terminal_progress.h"
 #include "cli/voronoi_commands.h"
@@ -48,6 +49,33 @@ void add_common(CLI::App* command, CommonFlags& flags) {
   command->add_option("--threads", flags.threads, "Worker threads (default: every core)")->check(CLI::Range(1, 4096));
   command->add_flag("--quiet,-q", flags.quiet, "No progress bars and no summary on the terminal");
   command->add_flag("--json", flags.json, "Print the report as JSON on standard output");
+}
+
+// `lacuna run --stream`: every output streamed slab by slab into its STL, checked chunk by chunk.
+int command_stream(const std::string& recipe, const StreamOptions& options, const CommonFlags& flags) {
+  const StreamReport result = stream_recipe(recipe, options);
+  const nlohmann::json r = to_json(result);
+  if (flags.json) std::cout << r.dump(2) << "\n";
+  if (!result.valid) {
+    std::cerr << "lacuna: " << recipe << ": a streamed output failed its checks; nothing was written\n";
+    for (const auto& out : r["outputs"])
+      for (const auto& problem : out["checks"]["problems"])
+        std::cerr << "  " << out["file"].get<std::string>() << ": " << problem.get<std::string>() << "\n";
+    return kExitCheckFailed;
+  }
+  if (!flags.json && !flags.quiet) {
+    double seconds = 0;
+    for (const auto& s : result.stage_seconds) seconds += s.second;
+    std::printf("lacuna: streamed %s in %.2f s\n", recipe.c_str(), seconds);
+    for (const StreamedOutput& out : result.outputs)
+      std::printf("  wrote %s  (%llu triangles, %.6g mm3, %llu component%s, genus %lld, %zu slab%s, checked in %zu chunk%s)\n",
+                  out.file.c_str(), (unsigned long long)out.triangles, out.check.volume_mm3,
+                  (unsigned long long)out.check.components, out.check.components == 1 ? "" : "s",
+                  (long long)out.check.genus, out.slabs, out.slabs == 1 ? "" : "s", out.check_chunks,
+                  out.check_chunks == 1 ? "" : "s");
+    if (options.run.write_report) std::printf("  wrote %s/report.json\n", result.output_dir.c_str());
+  }
+  return kExitOk;
 }
 
 int command_run(const std::string& recipe, const RunOptions& options, const CommonFlags& flags) {
@@ -341,6 +369,16 @@ int run_app(int argc, char** argv) {
       ->check(non_negative_number());
   run_command->add_option("--max-memory", max_memory_gb, "Memory budget in GB (default: half of the machine's memory)")
       ->check(number_in(0, 1e9, true));
+  bool stream = false;
+  double stream_slab_mm = 0;
+  run_command->add_flag("--stream", stream,
+                        "Stream the meshes: each object evaluated slab by slab along z and its surface written to\n"
+                        "its STL as it comes, then checked chunk by chunk (memory follows the slab, not the part;\n"
+                        "STL outputs only, no printability); the same file as a whole run where that fits");
+  run_command->add_option("--slab-mm", stream_slab_mm,
+                          "With --stream: slab height in mm, rounded up to blocks of 32 voxels (default: the whole part\n"
+                          "when it fits the budget, otherwise the highest slabs that do)")
+      ->check(non_negative_number());
   add_common(run_command, flags);
 
   std::string mesh_path;
@@ -460,6 +498,13 @@ int run_app(int argc, char** argv) {
   run_options.progress = current_progress_sink();
   try {
     run_options.max_memory_bytes = uint64_t(max_memory_gb * 1e9);
+    if (*run_command && (stream || stream_slab_mm > 0)) {
+      if (!stream) throw InvalidInput("--slab-mm: needs --stream");
+      StreamOptions stream_options;
+      stream_options.run = run_options;
+      stream_options.slab_mm = stream_slab_mm;
+      return command_stream(recipe, stream_options, flags);
+    }
     if (*run_command) return command_run(recipe, run_options, flags);
     if (*check) return command_check(mesh_path, flags, print, run_options.max_memory_bytes);
     if (*fea) return command_fea(fea_args, run_options, flags);

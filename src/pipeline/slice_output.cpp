@@ -19,6 +19,7 @@
 #include "export/output_files.h"
 #include "export/zip_archive.h"
 #include "pipeline/detail/memory.h"
+#include "pipeline/detail/slabs.h"
 #include "pipeline/build_inputs.h"
 #include "pipeline/evaluate.h"
 #include "pipeline/mesh_object.h"
@@ -115,17 +116,6 @@ void in_every_rank(SliceRanks* ranks, Step&& step) {
     case 6: throw Cancelled(message);
     default: throw InternalError(message);
   }
-}
-
-// A timer's stages, each started once per slab, added up by name in the order they first ran.
-std::vector<std::pair<std::string, double>> stage_totals(const StageTimer& timer) {
-  std::vector<std::pair<std::string, double>> totals;
-  for (const auto& [name, seconds] : timer.seconds()) {
-    auto same = std::find_if(totals.begin(), totals.end(), [&](const auto& t) { return t.first == name; });
-    if (same == totals.end()) totals.emplace_back(name, seconds);
-    else same->second += seconds;
-  }
-  return totals;
 }
 
 // Length-prefixed texts in one string (what processes hand each other).
@@ -305,21 +295,6 @@ void LayerSlicer::skip_to(double z_mm) {
 }
 
 namespace {
-
-// Slab i's own part is [cuts[i], cuts[i + 1]), cuts[i] = bottom + i height (each computed, not summed, so that
-// neighbours and every estimate agree to the bit), up to the first cut at or above `top`.
-std::vector<double> slab_cuts(double bottom, double top, double height) {
-  std::vector<double> cuts = {bottom};
-  while (cuts.back() < top) cuts.push_back(bottom + double(cuts.size()) * height);
-  return cuts;
-}
-
-// The slabs the cuts make, each grown by the halo below and above.
-std::vector<ZSlab> with_halo(const std::vector<double>& cuts, double halo) {
-  std::vector<ZSlab> slabs;
-  for (size_t i = 0; i + 1 < cuts.size(); ++i) slabs.push_back({cuts[i] - halo, cuts[i + 1] + halo});
-  return slabs;
-}
 
 template <typename T>
 void put(std::string& out, const T& v) {
@@ -529,41 +504,23 @@ SliceReport slice_recipe(Recipe recipe, const std::string& output, const SliceOp
   // Slabs of whole leaves (8 voxels) stacked from below the box; each is evaluated with a halo on
   // both sides deep enough that the object there equals the whole run's, and a band and a voxel
   // more for the layers' interpolation and the lowest point's search.
-  double halo = 0, bottom = 0, top = 0, whole = 0, slab_height = 0;  // slab_height 0: the whole part at once
+  detail::SlabLayout layout;
   in_every_rank(ranks, [&] {
     inputs.emplace(build_inputs(only, budget));
     p.emplace(plan(only));
     estimator.emplace(only, *p, *inputs);
     extent = estimator->extents().at(settings.name);
-    halo = std::ceil((extent.halo_mm + band + 2 * h) / leaf) * leaf;
-    bottom = std::floor((extent.box.min.z - band - h) / leaf) * leaf;
-    top = extent.box.max.z + band + 2 * h;
-    whole = std::ceil((top - bottom) / leaf) * leaf;
-    auto slabs_of = [&](double height) { return with_halo(slab_cuts(bottom, top, height), halo); };
-    if (options.slab_mm > 0) {
-      slab_height = std::ceil(options.slab_mm / leaf - 1e-9) * leaf;
-    } else if (estimator->bytes() > budget) {
-      // The highest slabs that fit (in leaves): the estimate grows with their height.
-      size_t lo = 1, hi = size_t(std::ceil(whole / leaf));
-      if (estimator->bytes(slabs_of(leaf)) > budget)
-        throw ResourceLimit(what + ": even slabs of " + detail::fixed(leaf, 4) + " mm (with a halo of " +
-                            detail::fixed(halo, 4) + " mm below and above) need more than the budget of " +
-                            format_bytes(budget) + "; use a larger voxel size or more memory");
-      while (hi - lo > 1) {
-        const size_t mid = (lo + hi) / 2;
-        (estimator->bytes(slabs_of(double(mid) * leaf)) <= budget ? lo : hi) = mid;
-      }
-      slab_height = double(lo) * leaf;
-    }
+    layout = detail::slab_layout(*estimator, extent, h, band, leaf, options.slab_mm, budget, what);
     if (settings.format == LayerFormat::kPng && me == 0) folder.emplace(output);
   });
+  const double halo = layout.halo, whole = layout.whole;
+  double& slab_height = layout.height;  // 0: the whole part at once
   if (ranks && (slab_height == 0 || slab_height * rank_count > whole))
     slab_height = std::ceil(whole / leaf / rank_count) * leaf;
   if (slab_height >= whole) slab_height = 0;
   // The first slab reaches down and the last up without end (their layers are theirs).
-  const std::vector<double> cuts =
-      slab_height > 0 ? slab_cuts(bottom, top, slab_height) : std::vector<double>{bottom, bottom + whole};
-  const std::vector<ZSlab> slabs = with_halo(cuts, halo);
+  const std::vector<double> cuts = layout.cuts();
+  const std::vector<ZSlab> slabs = layout.slabs();
   const size_t first_slab = slabs.size() * size_t(me) / size_t(rank_count);
   const size_t end_slab = slabs.size() * size_t(me + 1) / size_t(rank_count);
   auto slab_lo = [&](size_t i) { return i == 0 ? -std::numeric_limits<double>::infinity() : cuts[i]; };
@@ -682,7 +639,7 @@ SliceReport slice_recipe(Recipe recipe, const std::string& output, const SliceOp
       in_every_rank(ranks, [] {});
       report.valid = ranks->max(0) == 0;
       timer.stop();
-      report.stage_seconds = stage_totals(timer);
+      report.stage_seconds = detail::stage_totals(timer);
       return report;
     }
   }
@@ -733,7 +690,7 @@ SliceReport slice_recipe(Recipe recipe, const std::string& output, const SliceOp
   if (ranks) ranks->max(report.valid ? 0 : 1);
   spool.rollback();
   timer.stop();
-  report.stage_seconds = stage_totals(timer);
+  report.stage_seconds = detail::stage_totals(timer);
   return report;
 }
 

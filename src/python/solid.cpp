@@ -16,6 +16,7 @@
 #include "pipeline/mesh_object.h"
 #include "pipeline/pipeline.h"
 #include "pipeline/slice_output.h"
+#include "pipeline/stream_output.h"
 #include "python/convert.h"
 #include "python/objects.h"
 #include "recipe/json_fields.h"
@@ -646,6 +647,44 @@ void add_solids(py::module_& m) {
       "simplification, default a quarter pixel), slab_mm (evaluate slab by slab; None: only when the whole part does "
       "not fit max_memory_gb). Every layer is checked first; returns the report dict (as `--json` prints it), raises "
       "CheckFailedError (with .report) when a layer fails and nothing is written.");
+
+  m.def(
+      "stream",
+      [](const py::handle& recipe, const py::object& output_dir, const py::object& slab_mm, const py::object& voxel_size_mm,
+         const py::object& max_memory_gb, const py::object& threads, const py::object& simplify_mm, bool write_report) {
+        Recipe r = recipe_of(recipe);
+        StreamOptions options;
+        options.run.output_dir = output_dir.is_none() ? std::string() : path_of(output_dir);
+        if (!slab_mm.is_none()) options.slab_mm = slab_mm.cast<double>();
+        if (!voxel_size_mm.is_none()) {
+          options.run.voxel_size_mm = voxel_size_mm.cast<double>();
+          if (!(options.run.voxel_size_mm > 0)) throw InvalidInput("voxel_size_mm: expected a positive length in mm");
+        }
+        const ObjectOptions o = object_options(simplify_mm, max_memory_gb, threads);
+        options.run.simplify_mm = o.simplify_mm;
+        options.run.max_memory_bytes = o.max_memory_bytes;
+        options.run.threads = o.threads;
+        options.run.write_report = write_report;
+        const std::string label = r.file;
+        const StreamReport result = released([&] { return stream_recipe(std::move(r), options); });
+        const nlohmann::json report = to_json(result);
+        if (!result.valid) {
+          std::string message = label + ": a streamed output failed its checks; nothing was written";
+          for (const auto& out : report["outputs"])
+            for (const auto& problem : out["checks"]["problems"])
+              message += "\n  " + out["file"].get<std::string>() + ": " + problem.get<std::string>();
+          raise(errors().check_failed, message, from_json(report));
+        }
+        return from_json(report);
+      },
+      py::arg("recipe"), py::arg("output_dir") = py::none(), py::arg("slab_mm") = py::none(),
+      py::arg("voxel_size_mm") = py::none(), py::arg("max_memory_gb") = py::none(), py::arg("threads") = py::none(),
+      py::arg("simplify_mm") = py::none(), py::arg("write_report") = true,
+      "Streams a recipe's STL outputs as `lacuna run --stream` does: each object evaluated slab by slab (slab_mm "
+      "high, rounded up to blocks of 32 voxels; None: the whole part when it fits max_memory_gb, otherwise the highest "
+      "slabs that do), its surface simplified and written as it comes, then the file checked chunk by chunk; the same "
+      "file as run() writes. Returns the report dict (as `--json` prints it); raises CheckFailedError (with .report) "
+      "when a file fails its checks and nothing is written, ValueError for outputs a stream cannot write.");
 
   m.def(
       "voxelize",

@@ -142,3 +142,24 @@ def test_relative_mesh_files_are_read_from_where_the_solid_was_made(tmp_path, mo
     hull = lacuna.mesh(file="meshes/egg_hull.stl")
     monkeypatch.chdir(tmp_path)
     assert hull.voxelize(voxel_size_mm=0.5).active_voxels > 0
+
+
+def test_stream_writes_the_runs_file_slab_by_slab(tmp_path, source_dir):
+    recipe = json.loads((source_dir / "samples" / "menger_sponge.json").read_text())
+    recipe["outputs"] = [recipe["outputs"][0]]  # the STL
+    recipe["voxel_size_mm"] = 1 / 9
+    whole = lacuna.run(recipe, tmp_path / "whole", write_report=False)
+    assert whole.report["valid"]
+    report = lacuna.stream(recipe, tmp_path / "stream", slab_mm=4)
+    out = report["outputs"][0]
+    assert report["valid"] and out["checks"]["valid"]
+    assert out["slabs"] >= 4 and out["check_chunks"] >= 2
+    name = "menger_sponge.stl"
+    assert (tmp_path / "stream" / name).read_bytes() == (tmp_path / "whole" / name).read_bytes()
+    assert out["triangles"] == whole.report["outputs"][0]["triangles"]
+    assert out["genus"] == whole.report["outputs"][0]["genus"]
+    # What a stream cannot write is refused by name, and nothing is made.
+    recipe["outputs"].append({"of": "sponge", "file": "sponge.3mf"})
+    with pytest.raises(ValueError, match="a streamed run writes STL meshes"):
+        lacuna.stream(recipe, tmp_path / "refused")
+    assert not (tmp_path / "refused").exists()

@@ -196,6 +196,18 @@ def slice(
 ) -> Dict[str, Any]:
     """Layers for printers (PNG folder, .zip, .sl1, .cli) as `lacuna slice`: checked, all or nothing."""
 
+def stream(
+    recipe: _Recipe,
+    output_dir: Optional[_Path] = None,
+    slab_mm: Optional[float] = None,
+    voxel_size_mm: Optional[float] = None,
+    max_memory_gb: Optional[float] = None,
+    threads: Optional[int] = None,
+    simplify_mm: Optional[float] = None,
+    write_report: bool = True,
+) -> Dict[str, Any]:
+    """STL outputs streamed slab by slab as `lacuna run --stream`: the run's files, checked chunk by chunk."""
+
 def voxelize(
     recipe: _Recipe,
     object: str = "",
