@@ -96,6 +96,14 @@ OutputTransaction::~OutputTransaction() {
   if (!done_) rollback();
 }
 
+ScratchFile::ScratchFile(std::string path) : path_(std::move(path)) { track(path_, false); }
+
+ScratchFile::~ScratchFile() {
+  std::error_code ignored;
+  std::filesystem::remove(path_, ignored);
+  untrack(path_);
+}
+
 std::string OutputTransaction::stage(const std::string& final_path) {
   if (done_) throw std::logic_error("OutputTransaction::stage after commit or rollback");
   if (final_path.empty() || std::filesystem::path(final_path).filename().empty()) {

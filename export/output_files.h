@@ -52,6 +52,20 @@ class OutputTransaction {
 // Writes `bytes` as the whole file `path` (created or truncated). Throws IoError naming it on failure.
 void write_whole_file(const std::string& path, const std::string& bytes);
 
+// A scratch file a job writes beside its outputs and never keeps (a spool): an interrupt removes it
+// as it removes the job's temporaries, and so does the destructor.
+class ScratchFile {
+ public:
+  explicit ScratchFile(std::string path);
+  ~ScratchFile();
+  ScratchFile(const ScratchFile&) = delete;
+  ScratchFile& operator=(const ScratchFile&) = delete;
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
 // Writes a whole text file through a temporary name and a rename. Throws IoError on failure.
 void write_text_file_atomically(const std::string& path, const std::string& text);
 

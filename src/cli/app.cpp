@@ -53,6 +53,11 @@ void add_common(CLI::App* command, CommonFlags& flags) {
 
 // `lacuna run --stream`: every output streamed slab by slab into its STL, checked chunk by chunk.
 int command_stream(const std::string& recipe, const StreamOptions& options, const CommonFlags& flags) {
+  // One process writes a streamed mesh: under mpirun every rank would write the same folder.
+  const std::unique_ptr<SliceRanks> ranks = mpi_ranks();
+  if (ranks && ranks->size() > 1)
+    throw InvalidInput("--stream: a streamed mesh is written by one process (run it without mpirun; `lacuna slice` "
+                       "splits its slabs over MPI ranks)");
   const StreamReport result = stream_recipe(recipe, options);
   const nlohmann::json r = to_json(result);
   if (flags.json) std::cout << r.dump(2) << "\n";

@@ -72,14 +72,12 @@ class VertexSets {
 // removed when done.
 class NumberSpool {
  public:
-  explicit NumberSpool(std::string path) : path_(std::move(path)) {
+  explicit NumberSpool(const std::string& path) : scratch_(path), path_(path) {
     file_ = std::fopen(path_.c_str(), "w+b");
     if (!file_) throw IoError("cannot create '" + path_ + "': " + std::strerror(errno));
   }
   ~NumberSpool() {
     if (file_) std::fclose(file_);
-    std::error_code ignored;
-    fs::remove(path_, ignored);
   }
   void put(const std::array<uint64_t, 3>& n) {
     const uint32_t v[3] = {uint32_t(n[0]), uint32_t(n[1]), uint32_t(n[2])};
@@ -96,6 +94,7 @@ class NumberSpool {
   }
 
  private:
+  ScratchFile scratch_;  // removed last, after the file is closed
   std::string path_;
   std::FILE* file_ = nullptr;
 };
@@ -239,7 +238,8 @@ StreamedOutput stream_output(const Recipe& recipe, const RecipeOutput& out, cons
     }
   }
   if (!dropped.empty()) {
-    const std::string kept_path = temp + ".kept";
+    const ScratchFile kept_file(temp + ".kept");
+    const std::string& kept_path = kept_file.path();
     numbers.rewind();
     {
       StlWriter kept(kept_path, header);
