@@ -1072,6 +1072,7 @@ uint64_t StlWriter::triangles() const { return impl_->triangles; }
 
 void StlWriter::finish() {
   Impl& m = *impl_;
+  if (m.finished) return;
   m.flush();
   unsigned char count[4];
   store_le32(static_cast<uint32_t>(m.triangles), count);

@@ -538,7 +538,7 @@ struct ChunkedCheck::Impl {
   MeshCheckReport r;
   std::vector<std::array<Vec3d, 3>> previous;  // the last chunk given
   size_t chunks = 0;
-  double z_max_before = -HUGE_VAL;  // the top of the chunk before `previous`
+  double z_max_before = -HUGE_VAL;  // the top of every chunk before `previous`
   double z_max_previous = -HUGE_VAL;
   bool done = false;
   bool separated = true;            // every chunk above the one two before it
@@ -754,7 +754,7 @@ struct ChunkedCheck::Impl {
     }
     const uint32_t probe_base = uint32_t(probes.size());
     for (uint32_t c : own) probes.push_back({base + c});
-    if (components.count > 1 || !probes.empty())
+    if (!probe.empty())
       for (const auto& [q, c] : odd_crossings(m, components.of_vertex, probe, own)) crossings.push_back({probe_base + q, base + c});
     // Self-intersections among the window's faces.
     if (options.self_intersections && edges_clean && bad_fans == 0) {
@@ -782,7 +782,7 @@ void ChunkedCheck::add(std::vector<std::array<Vec3d, 3>> chunk, bool last) {
   if (m.chunks == 0 && last) m.window(chunk, {}, true, true);
   if (m.chunks >= 1) m.window(m.previous, chunk, m.chunks == 1, last);
   ++m.chunks;
-  m.z_max_before = m.z_max_previous;
+  m.z_max_before = std::max(m.z_max_before, m.z_max_previous);  // the top of every chunk but the last
   m.z_max_previous = hi;
   m.previous = std::move(chunk);
   m.done = last;
@@ -817,8 +817,10 @@ MeshCheckReport ChunkedCheck::finish() {
   }
   std::vector<std::pair<uint32_t, uint32_t>> crossed;  // (probe, root crossed), one per odd crossing
   for (const auto& [q, node] : m.crossings) {
-    const uint32_t root = m.find(node);
-    if (probe_of[m.find(m.probes[q].node)] == q) crossed.push_back({q, root});
+    // A window may hold a component in pieces joined only later (a cup's inner and outer walls): a
+    // crossing with another piece of the probe's own component is no nesting.
+    const uint32_t root = m.find(node), own = m.find(m.probes[q].node);
+    if (probe_of[own] == q && root != own) crossed.push_back({q, root});
   }
   std::sort(crossed.begin(), crossed.end());
   std::vector<uint32_t> depth(m.probes.size(), 0);

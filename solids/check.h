@@ -58,8 +58,10 @@ std::vector<uint32_t> component_depths(const TriMesh& mesh);
 
 // check_mesh's checks of a mesh too large to hold, read in chunks of whole triangles as written
 // (corners as float triples, shared corners equal), two chunks at a time: so every triangle of a
-// chunk must lie above (in z) every triangle two chunks before it, or self-intersections count as
-// not checked. The figures are the whole mesh's (the volume up to rounding).
+// chunk must lie above (in z) every triangle of the chunks before the last, which is tested (when it
+// does not hold, self-intersections count as not checked and the figures are not the mesh's). The
+// figures are the whole mesh's (the volume up to rounding; problem edges of an invalid mesh may be
+// counted in two windows).
 class ChunkedCheck {
  public:
   explicit ChunkedCheck(const CheckOptions& options = {});

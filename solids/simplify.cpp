@@ -1678,8 +1678,10 @@ void StreamedSurface::add(const Volume& volume, int64_t z0_voxels, int64_t z1_vo
     m.add_blocks(results);
   }
   if (z1_voxels == kUnbounded) return;
+  // Every vertex half a block below the cut has all its blocks in (the regions run next read none
+  // above z1 - 1 block); a vertex on the cut plane lies far above that, whatever float rounding does.
   const double z1_mm = double(z1_voxels) * m.h;
-  m.settle(z1_mm - 0.001 * m.h);
+  m.settle(z1_mm - 0.5 * m.lattice.side);
   // The regions whose top lies 1.5 blocks below z1: (k + 1 - kShift) side <= z1 - 1.5 side.
   const int64_t c = z1_voxels / kBlockVoxels;
   m.run_regions(c + (int64_t(1) << 20) - 2);

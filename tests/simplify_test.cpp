@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <set>
@@ -354,6 +355,28 @@ TEST(Simplify, ChunkedCheckReadsAsTheWholeCheck) {
       EXPECT_TRUE(chunked.self_intersections_checked || !whole.self_intersections_checked) << what << ", " << height;
       expect_same_report(chunked, whole, what + ", bands of " + std::to_string(height) + " mm");
     }
+  }
+  // A cup taller than two bands: its inner and outer walls meet only at the rim, so the windows below
+  // hold them apart (a ray from an inner wall crosses the outer wall: no nesting, it is one component).
+  const Recipe cup_recipe = parse_recipe(R"({"lacuna_recipe": 1, "name": "cup", "voxel_size_mm": 0.1,
+    "inputs": {"outer": {"type": "box", "min_mm": [-3.02, -3.03, 0.01], "max_mm": [3.01, 3.04, 14.02]},
+               "inner": {"type": "box", "min_mm": [-2.01, -2.02, 1.03], "max_mm": [2.03, 2.01, 15]}},
+    "operations": [{"name": "cup", "op": "difference", "of": ["outer", "inner"]}],
+    "outputs": [{"of": "cup", "file": "cup.stl"}]})", "cup.json");
+  TriMesh cup = extract_simplified_surface(evaluate_object(cup_recipe, "cup"), options);
+  ASSERT_TRUE(check_mesh(cup).valid());
+  // The inner walls' faces first (a chunk's order is the file's, any order): the first ray the check
+  // casts for the cup starts on an inner wall.
+  auto off_axis = [&](const std::array<uint32_t, 3>& t) {
+    const Vec3d c = (cup.positions_mm[t[0]] + cup.positions_mm[t[1]] + cup.positions_mm[t[2]]) / 3.0;
+    return std::max(std::fabs(c.x), std::fabs(c.y));
+  };
+  std::stable_sort(cup.triangles.begin(), cup.triangles.end(),
+                   [&](const auto& a, const auto& b) { return off_axis(a) < off_axis(b); });
+  for (double height : {2.0, 3.0, 4.0}) {
+    const MeshCheckReport chunked = chunked_check(cup, height);
+    EXPECT_EQ(chunked.inward_components, 0u) << "bands of " << height << " mm";
+    expect_same_report(chunked, check_mesh(cup), "cup, bands of " + std::to_string(height) + " mm");
   }
   EXPECT_TRUE(check_mesh(part).valid());
   EXPECT_TRUE(check_mesh(with_cavity).valid());

@@ -257,6 +257,7 @@ StreamedOutput stream_output(const Recipe& recipe, const RecipeOutput& out, cons
     if (error) throw IoError(final_path + ": cannot replace the streamed file: " + error.message());
     batches.erase(std::remove_if(batches.begin(), batches.end(), [](const Batch& b) { return b.count == 0; }),
                   batches.end());
+    if (batches.empty()) throw InvalidInput(what + " is empty: nothing is left to mesh");
   }
 
   // The file as written, chunk by chunk.
