@@ -30,6 +30,12 @@ int orient_yz(const Vec3d& a, const Vec3d& b, const Vec3d& p) {
   return b.y > a.y ? 1 : (b.y < a.y ? -1 : 0);
 }
 
+// A repeated corner or three collinear corners (exact predicate).
+bool degenerate_face(const TriMesh& mesh, const std::array<uint32_t, 3>& t) {
+  return t[0] == t[1] || t[1] == t[2] || t[0] == t[2] ||
+         exact::collinear(mesh.positions_mm[t[0]], mesh.positions_mm[t[1]], mesh.positions_mm[t[2]]);
+}
+
 // Whether the ray from p along +x crosses triangle abc (exact predicates).
 bool ray_crosses(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& p) {
   int s = exact::orient2d(a.y, a.z, b.y, b.z, c.y, c.z);
@@ -436,9 +442,7 @@ MeshCheckReport check_mesh(const TriMesh& mesh, const CheckOptions& options) {
       tbb::blocked_range<size_t>(0, nf, 4096), uint64_t{0},
       [&](const tbb::blocked_range<size_t>& range, uint64_t n) {
         for (size_t f = range.begin(); f != range.end(); ++f) {
-          const auto& t = mesh.triangles[f];
-          if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2] ||
-              exact::collinear(mesh.positions_mm[t[0]], mesh.positions_mm[t[1]], mesh.positions_mm[t[2]])) {
+          if (degenerate_face(mesh, mesh.triangles[f])) {
             degenerate[f] = 1;
             ++n;
           }
@@ -635,8 +639,7 @@ struct ChunkedCheck::Impl {
     std::vector<uint8_t> degenerate(nf, 0);
     for (size_t f = 0; f < nf; ++f) {
       const auto& t = m.triangles[f];
-      if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2] ||
-          exact::collinear(m.positions_mm[t[0]], m.positions_mm[t[1]], m.positions_mm[t[2]])) {
+      if (degenerate_face(m, t)) {
         degenerate[f] = 1;
         r.degenerate_faces += counted_face(f);
       }

@@ -18,6 +18,7 @@
 
 #include "errors.h"
 #include "export/mesh_io.h"
+#include "pipeline/mesh_object.h"
 #include "pipeline/slice_output.h"
 #include "pipeline/stream_output.h"
 #include "solids/check.h"
@@ -459,15 +460,8 @@ TEST(Slice, SlabBySlabGivesTheWholeRunsBytes) {
 
 // The recipe with one STL output of `object` and nothing a streamed run refuses.
 Recipe one_stl(const std::string& path, const std::string& object, double voxel_mm) {
-  Recipe recipe = load_recipe(path);
+  Recipe recipe = recipe_for_object(load_recipe(path), object);
   if (voxel_mm > 0) recipe.voxel_size_mm = voxel_mm;
-  RecipeOutput out;
-  out.object = object;
-  out.file = object + ".stl";
-  out.format = "stl";
-  out.part_name = object;
-  out.json_path = "outputs[0]";
-  recipe.outputs = {out};
   recipe.printability = PrintabilitySettings{};
   return recipe;
 }

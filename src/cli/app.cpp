@@ -51,6 +51,13 @@ void add_common(CLI::App* command, CommonFlags& flags) {
   command->add_flag("--json", flags.json, "Print the report as JSON on standard output");
 }
 
+// Each output's failed checks, from a run's or a streamed run's report, to stderr.
+void print_output_problems(const nlohmann::json& report) {
+  for (const auto& out : report["outputs"])
+    for (const auto& problem : out["checks"]["problems"])
+      std::cerr << "  " << out["file"].get<std::string>() << ": " << problem.get<std::string>() << "\n";
+}
+
 // `lacuna run --stream`: every output streamed slab by slab into its STL, checked chunk by chunk.
 int command_stream(const std::string& recipe, const StreamOptions& options, const CommonFlags& flags) {
   // One process writes a streamed mesh: under mpirun every rank would write the same folder.
@@ -63,9 +70,7 @@ int command_stream(const std::string& recipe, const StreamOptions& options, cons
   if (flags.json) std::cout << r.dump(2) << "\n";
   if (!result.valid) {
     std::cerr << "lacuna: " << recipe << ": a streamed output failed its checks; nothing was written\n";
-    for (const auto& out : r["outputs"])
-      for (const auto& problem : out["checks"]["problems"])
-        std::cerr << "  " << out["file"].get<std::string>() << ": " << problem.get<std::string>() << "\n";
+    print_output_problems(r);
     return kExitCheckFailed;
   }
   if (!flags.json && !flags.quiet) {
@@ -89,9 +94,7 @@ int command_run(const std::string& recipe, const RunOptions& options, const Comm
   if (flags.json) std::cout << r.dump(2) << "\n";
   if (!result.valid) {
     std::cerr << "lacuna: " << recipe << ": an output failed its checks; nothing was written\n";
-    for (const auto& out : r["outputs"])
-      for (const auto& problem : out["checks"]["problems"])
-        std::cerr << "  " << out["file"].get<std::string>() << ": " << problem.get<std::string>() << "\n";
+    print_output_problems(r);
     return kExitCheckFailed;
   }
   if (!flags.json && !flags.quiet) {

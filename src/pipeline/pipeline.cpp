@@ -14,11 +14,7 @@ namespace {
 
 // The stages after reading: the recipe's time to read (and its inputs' to build) is `read`.
 RunReport run_read(Recipe recipe, const RunOptions& options, StageTimer& read) {
-  if (options.voxel_size_mm > 0) recipe.voxel_size_mm = options.voxel_size_mm;
-  if (options.simplify_mm >= 0) {
-    recipe.simplify_mm = options.simplify_mm;
-    for (RecipeOutput& out : recipe.outputs) out.simplify_mm.reset();
-  }
+  apply_run_options(recipe, options);
   const uint64_t budget = options.max_memory_bytes ? options.max_memory_bytes : available_memory_bytes() / 2;
   WriteOptions write_options;
   write_options.output_dir = options.output_dir;
@@ -42,7 +38,8 @@ std::unique_ptr<tbb::global_control> thread_limit(int threads) {
   return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(threads));
 }
 
-// Throws InvalidInput for options no run can use (NaN ignored silently would run something else).
+}  // namespace
+
 void check_run_options(const RunOptions& options) {
   if (options.voxel_size_mm != 0 &&
       !(options.voxel_size_mm >= kMinVoxelSizeMm && options.voxel_size_mm <= kMaxVoxelSizeMm))
@@ -56,7 +53,13 @@ void check_run_options(const RunOptions& options) {
     throw InvalidInput("output folder: a path may not hold a NUL character");
 }
 
-}  // namespace
+void apply_run_options(Recipe& recipe, const RunOptions& options) {
+  if (options.voxel_size_mm > 0) recipe.voxel_size_mm = options.voxel_size_mm;
+  if (options.simplify_mm >= 0) {
+    recipe.simplify_mm = options.simplify_mm;
+    for (RecipeOutput& out : recipe.outputs) out.simplify_mm.reset();
+  }
+}
 
 RunReport run(const std::string& recipe_path, const RunOptions& options) {
   check_run_options(options);

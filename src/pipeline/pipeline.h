@@ -35,6 +35,12 @@ struct RunOptions {
   bool write_report = true;          // report.json and report.html next to the outputs
 };
 
+// Throws InvalidInput for options no run can use (NaN ignored silently would run something else).
+void check_run_options(const RunOptions& options);
+// The options' voxel size and simplification deviation, where given, in place of the recipe's (and
+// of its outputs' own deviations).
+void apply_run_options(Recipe& recipe, const RunOptions& options);
+
 // Runs the recipe at `recipe_path`: reads it, builds its inputs, refuses what would not fit the
 // memory budget before allocating it, evaluates, writes, re-reads and checks every output, all or
 // nothing. Throws IoError or InvalidInput for bad recipes and input meshes, ResourceLimit beyond the

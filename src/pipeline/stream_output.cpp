@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "errors.h"
 #include "export/mesh_io.h"
@@ -214,7 +215,6 @@ StreamedOutput stream_output(const Recipe& recipe, const RecipeOutput& out, cons
     double volume6 = 0;
   };
   std::unordered_map<uint32_t, Shell> shells;
-  std::vector<uint32_t> root_of;  // per triangle of a batch
   for (const Batch& b : batches) {
     const std::vector<std::array<Vec3d, 3>> corners = read_stl_triangles(temp, b.first, b.count);
     for (const auto& c : corners) {
@@ -226,14 +226,14 @@ StreamedOutput stream_output(const Recipe& recipe, const RecipeOutput& out, cons
     }
   }
   const double smallest = h * h * h;
-  std::unordered_map<uint32_t, bool> dropped;
+  std::unordered_set<uint32_t> dropped;
   for (const auto& [root, shell] : shells) {
     const double v = shell.volume6 / 6;
     if (v < 0 && -v < smallest) {
-      dropped[root] = true;
+      dropped.insert(root);
       ++result.cavities_filled;
     } else if (v >= 0 && v < smallest) {
-      dropped[root] = true;
+      dropped.insert(root);
       ++result.specks_removed;
     }
   }
@@ -282,22 +282,18 @@ StreamedOutput stream_output(const Recipe& recipe, const RecipeOutput& out, cons
   return result;
 }
 
-}  // namespace
-
-StreamReport stream_recipe(const std::string& recipe_path, const StreamOptions& options) {
-  return stream_recipe(load_recipe(recipe_path), options);
-}
-
-StreamReport stream_recipe(Recipe recipe, const StreamOptions& options) {
-  const RunOptions& run = options.run;
+// Throws InvalidInput for options no streamed run can use (before a recipe is read).
+void check_stream_options(const StreamOptions& options) {
+  check_run_options(options.run);
   if (!(options.slab_mm >= 0) || !std::isfinite(options.slab_mm))
     throw InvalidInput("slab height: expected a positive height in mm, or 0 to choose one, got " +
                        message_number(options.slab_mm));
-  if (run.voxel_size_mm > 0) recipe.voxel_size_mm = run.voxel_size_mm;
-  if (run.simplify_mm >= 0) {
-    recipe.simplify_mm = run.simplify_mm;
-    for (RecipeOutput& out : recipe.outputs) out.simplify_mm.reset();
-  }
+}
+
+// stream_recipe with the options checked.
+StreamReport stream_checked(Recipe recipe, const StreamOptions& options) {
+  const RunOptions& run = options.run;
+  apply_run_options(recipe, run);
   std::optional<tbb::global_control> threads;
   if (run.threads > 0) threads.emplace(tbb::global_control::max_allowed_parallelism, size_t(run.threads));
   ProgressSinkScope progress(run.progress ? run.progress : current_progress_sink());
@@ -331,6 +327,18 @@ StreamReport stream_recipe(Recipe recipe, const StreamOptions& options) {
   transaction.commit();
   folder->keep();
   return report;
+}
+
+}  // namespace
+
+StreamReport stream_recipe(const std::string& recipe_path, const StreamOptions& options) {
+  check_stream_options(options);
+  return stream_checked(load_recipe(recipe_path), options);
+}
+
+StreamReport stream_recipe(Recipe recipe, const StreamOptions& options) {
+  check_stream_options(options);
+  return stream_checked(std::move(recipe), options);
 }
 
 nlohmann::json to_json(const StreamReport& report) {

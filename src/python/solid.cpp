@@ -436,6 +436,14 @@ const char* kInputDocs[][2] = {
      "face_lacuna_scale, gap_fraction, notch_depth, realization."},
 };
 
+// `headline` and, a line each, every output's failed checks in a run's or a streamed run's report.
+std::string with_output_problems(std::string headline, const nlohmann::json& report) {
+  for (const auto& out : report["outputs"])
+    for (const auto& problem : out["checks"]["problems"])
+      headline += "\n  " + out["file"].get<std::string>() + ": " + problem.get<std::string>();
+  return headline;
+}
+
 }  // namespace
 
 void add_solids(py::module_& m) {
@@ -580,11 +588,9 @@ void add_solids(py::module_& m) {
         report["valid"] = result.valid;
         report["written"] = result.written;
         if (!result.valid) {
-          std::string message = label + ": an output failed its checks; nothing was written";
-          for (const auto& out : report["outputs"])
-            for (const auto& problem : out["checks"]["problems"])
-              message += "\n  " + out["file"].get<std::string>() + ": " + problem.get<std::string>();
-          raise(errors().check_failed, message, from_json(report));
+          raise(errors().check_failed,
+                with_output_problems(label + ": an output failed its checks; nothing was written", report),
+                from_json(report));
         }
         RunResult out;
         out.report = from_json(report);
@@ -669,11 +675,9 @@ void add_solids(py::module_& m) {
         const StreamReport result = released([&] { return stream_recipe(std::move(r), options); });
         const nlohmann::json report = to_json(result);
         if (!result.valid) {
-          std::string message = label + ": a streamed output failed its checks; nothing was written";
-          for (const auto& out : report["outputs"])
-            for (const auto& problem : out["checks"]["problems"])
-              message += "\n  " + out["file"].get<std::string>() + ": " + problem.get<std::string>();
-          raise(errors().check_failed, message, from_json(report));
+          raise(errors().check_failed,
+                with_output_problems(label + ": a streamed output failed its checks; nothing was written", report),
+                from_json(report));
         }
         return from_json(report);
       },
