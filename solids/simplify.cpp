@@ -1494,6 +1494,7 @@ struct StreamedSurface::Impl {
   // Face vertices whose blocks are not all in: (block, debt) per block so far.
   std::unordered_map<uint64_t, std::vector<std::pair<uint64_t, double>>> unsettled;
   int64_t regions_done = -1;                  // regions with z index up to this have run
+  int64_t lead_in_until = kUnbounded;         // a part's first slab starts here or below
   int64_t z_end = std::numeric_limits<int64_t>::min();  // the voxels added so far end here
   uint64_t next_number = 0;
   SimplifyStats stats;
@@ -1566,7 +1567,10 @@ struct StreamedSurface::Impl {
 
   // Runs the regions up to z index `until`, emits their triangles and keeps what later regions meet.
   void run_regions(int64_t until) {
-    if (until <= regions_done) return;
+    if (until <= regions_done) {  // a part's lead-in: keep only what the part's regions meet
+      keep_after(regions_done);
+      return;
+    }
     std::vector<std::array<uint32_t, 3>> out;
     if (!triangles.empty()) {
       PassScope scope;
@@ -1589,7 +1593,12 @@ struct StreamedSurface::Impl {
       stats.output_triangles += out.size();
       emit(batch);
     }
-    // Keep the triangles a later region meets (its open box, or its half-open box holding the centroid).
+    keep_after(until);
+  }
+
+  // Keeps the triangles a region after `until` meets (its open box, or its half-open box holding
+  // the centroid), and their vertices.
+  void keep_after(int64_t until) {
     const double top = lattice.boundary(2, until + 1);
     size_t kept = 0;
     for (size_t t = 0; t < triangles.size(); ++t) {
@@ -1662,6 +1671,9 @@ void StreamedSurface::add(const Volume& volume, int64_t z0_voxels, int64_t z1_vo
     throw InternalError("StreamedSurface::add: slabs must follow each other on whole blocks of 32 voxels");
   if (!volume.empty() && std::fabs(volume.voxel_size_mm() - m.h) > 1e-12 * m.h)
     throw InternalError("StreamedSurface::add: a slab of another voxel size");
+  if (m.z_end == std::numeric_limits<int64_t>::min() && m.lead_in_until != kUnbounded &&
+      !(z0_voxels <= m.lead_in_until))
+    throw InternalError("StreamedSurface::add: a part's first slab must start three blocks below its cut");
   m.z_end = z1_voxels;
   if (!volume.empty()) {
     ExtractOptions extract;
@@ -1691,6 +1703,21 @@ void StreamedSurface::finish() {
   m.settle(std::numeric_limits<double>::infinity());
   m.run_regions((int64_t(1) << 21) - 1);
   m.finished = true;
+}
+
+void StreamedSurface::begin_after(int64_t cut_voxels) {
+  Impl& m = *impl_;
+  if (m.z_end != std::numeric_limits<int64_t>::min() || m.finished || cut_voxels % kBlockVoxels != 0)
+    throw InternalError("StreamedSurface::begin_after: before the first slab, at a whole block");
+  m.regions_done = cut_voxels / kBlockVoxels + (int64_t(1) << 20) - 2;  // as add() runs them after that cut
+  m.lead_in_until = cut_voxels - 3 * kBlockVoxels;
+}
+
+std::vector<StreamedSurface::WindowVertex> StreamedSurface::window_vertices() const {
+  const Impl& m = *impl_;
+  std::vector<WindowVertex> out(m.numbers.size());
+  for (size_t v = 0; v < out.size(); ++v) out[v] = {m.numbers[v], {m.window.order[v].first, m.window.order[v].second}};
+  return out;
 }
 
 const SimplifyStats& StreamedSurface::stats() const { return impl_->stats; }

@@ -83,6 +83,22 @@ class StreamedSurface {
   const SimplifyStats& stats() const;
   uint64_t numbers_given() const;
 
+  // One part of a surface streamed by several processes, each a block of the slabs: this one emits
+  // only the triangles the whole stream emits after a slab ending at `cut_voxels` (a whole block),
+  // up to the end of its last add (then finish, only for the last part). Call before the first add,
+  // whose slabs must start at least three blocks below the cut (those below it are a lead-in: their
+  // blocks are simplified again here, their regions are not run). Concatenated in order, the parts'
+  // triangles are the whole stream's.
+  void begin_after(int64_t cut_voxels);
+  // The vertices in the window now (those a later triangle may still use), each with its number
+  // and its identity in the whole surface (the same in every part that has the vertex). After the
+  // lead-in, and after a part's last add: a vertex both parts emit is in both lists.
+  struct WindowVertex {
+    uint64_t number;
+    std::array<uint64_t, 2> identity;
+  };
+  std::vector<WindowVertex> window_vertices() const;
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;

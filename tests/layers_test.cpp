@@ -612,7 +612,7 @@ TEST(Slice, TheBudgetPicksTheSlabsAndNothingIsLeftBehind) {
 }
 
 // Processes of one job played by threads: every exchange waits for all of them (a barrier per call).
-class ThreadRanks : public SliceRanks {
+class ThreadRanks : public JobRanks {
  public:
   struct Shared {
     explicit Shared(int n) : slots(size_t(n)) {}
@@ -717,6 +717,69 @@ TEST(Slice, ProcessesShareTheSlabsAndFailTogether) {
     const std::string name = entry.path().filename().string();
     EXPECT_TRUE(name == "alone.zip" || name == "ranks.zip") << name;
   }
+}
+
+TEST(Stream, ProcessesShareTheSlabsAndFailTogether) {
+  TempDir dir;
+  const Recipe recipe = one_stl(std::string(LACUNA_SOURCE_DIR) + "/samples/hollow_sphere.json", "hollow", 0.15);
+  StreamOptions alone;
+  alone.run.output_dir = (dir / "alone").string();
+  const StreamReport single = stream_recipe(recipe, alone);
+  ASSERT_TRUE(single.valid);
+  // Three processes (threads here; `mpirun` in tests/python/test_mpi.py): the part is six blocks of
+  // 32 voxels high (4.8 mm), so the first meshes four, the others one each after their lead-ins of
+  // three (the work even: four blocks each).
+  {
+    ThreadRanks::Shared shared(3);
+    std::vector<StreamReport> reports(3);
+    std::vector<std::thread> threads;
+    for (int r = 0; r < 3; ++r)
+      threads.emplace_back([&, r] {
+        ThreadRanks ranks(shared, r);
+        StreamOptions options;
+        options.run.output_dir = (dir / "ranks").string();
+        options.ranks = &ranks;
+        reports[size_t(r)] = stream_recipe(recipe, options);
+      });
+    for (std::thread& t : threads) t.join();
+    for (const StreamReport& report : reports) EXPECT_TRUE(report.valid);
+    ASSERT_EQ(reports[0].outputs.size(), 1u);
+    const StreamedOutput &o = reports[0].outputs[0], &one = single.outputs[0];
+    EXPECT_EQ(o.slabs, 3u);
+    EXPECT_NEAR(o.slab_mm, 4 * 4.8, 1e-9);  // the tallest
+    EXPECT_EQ(o.triangles, one.triangles);
+    EXPECT_EQ(o.extracted_triangles, one.extracted_triangles);
+    EXPECT_EQ(o.check.components, 2u);
+    EXPECT_EQ(o.check.genus, one.check.genus);
+    EXPECT_TRUE(test::read_file(dir / "alone" / "hollow.stl") == test::read_file(dir / "ranks" / "hollow.stl"));
+    std::vector<std::string> names;
+    for (const auto& entry : fs::directory_iterator(dir / "ranks")) names.push_back(entry.path().filename().string());
+    std::sort(names.begin(), names.end());
+    EXPECT_EQ(names, (std::vector<std::string>{"hollow.stl", "report.json"}));  // no part left beside it
+  }
+  // Process 1 is stopped while it streams its part: it ends with its own error, the other with one
+  // naming it, and nothing is written.
+  ThreadRanks::Shared shared(2);
+  std::vector<std::string> errors(2);
+  std::vector<std::thread> threads;
+  StopAtOnce stop;
+  for (int r = 0; r < 2; ++r)
+    threads.emplace_back([&, r] {
+      ThreadRanks ranks(shared, r);
+      StreamOptions options;
+      options.run.output_dir = (dir / "failed").string();
+      options.ranks = &ranks;
+      if (r == 1) options.run.progress = &stop;
+      try {
+        stream_recipe(recipe, options);
+      } catch (const Cancelled& e) {
+        errors[size_t(r)] = e.what();
+      }
+    });
+  for (std::thread& t : threads) t.join();
+  EXPECT_NE(errors[0].find("process 1 of 2 failed"), std::string::npos) << errors[0];
+  EXPECT_FALSE(errors[1].empty());
+  EXPECT_FALSE(fs::exists(dir / "failed"));
 }
 
 TEST(Slice, RecipeOutputsAreTheSameLayersWithoutAMesh) {

@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
+#include <numeric>
 #include <set>
 
 #include "cifs/library.h"
@@ -276,6 +278,120 @@ TEST(Simplify, StreamedSlabBySlabIsTheWholeSurface) {
       std::set<uint64_t> numbers;
       for (const auto& n : s.numbers) numbers.insert(n.begin(), n.end());
       EXPECT_EQ(numbers.size(), number_of.size()) << what << ": one number per vertex";
+    }
+  }
+}
+
+// The surface streamed in `parts` parts as a job's processes stream it: slabs of 32 voxels, each
+// part a block of them, starting after its first cut with a lead-in from three blocks below it.
+struct StreamedPart {
+  Streamed emitted;
+  std::vector<StreamedSurface::WindowVertex> lead, tail;
+};
+std::vector<StreamedPart> stream_parts(const Volume& volume, const SimplifyOptions& options, const Box3& box, size_t parts) {
+  const double h = volume.voxel_size_mm();
+  const int64_t start = int64_t(std::floor(box.min.z / h / 32)) * 32;
+  std::vector<int64_t> z0{-StreamedSurface::kUnbounded}, z1;  // slab i: [z0[i], z1[i])
+  for (int64_t z = start + 32; double(z - 32) * h < box.max.z; z += 32) {
+    z1.push_back(z);
+    z0.push_back(z);
+  }
+  z1.push_back(StreamedSurface::kUnbounded);
+  const size_t n = z0.size();
+  std::vector<StreamedPart> out(parts);
+  for (size_t p = 0; p < parts; ++p) {
+    const size_t first = n * p / parts, end = n * (p + 1) / parts;
+    StreamedPart& part = out[p];
+    StreamedSurface surface(options, h, [&](const EmittedTriangles& batch) {
+      part.emitted.corners.insert(part.emitted.corners.end(), batch.corners.begin(), batch.corners.end());
+      part.emitted.numbers.insert(part.emitted.numbers.end(), batch.numbers.begin(), batch.numbers.end());
+      ++part.emitted.batches;
+    });
+    size_t from = first;
+    if (first > 0) {
+      surface.begin_after(z0[first]);
+      from = first - 3;  // slabs of one block: three below the cut
+    }
+    for (size_t i = from; i < end; ++i) {
+      surface.add(volume, z0[i], z1[i]);
+      if (i + 1 == first) part.lead = surface.window_vertices();
+    }
+    if (end == n)
+      surface.finish();
+    else
+      part.tail = surface.window_vertices();
+  }
+  return out;
+}
+
+TEST(Simplify, StreamedInPartsIsTheWholeSurface) {
+  GeometrySet set = sphere({0.1, 0.2, 0.3}, 3);
+  set.tubes.tubes.push_back(Tube{{{-4, 0, -6}, {4, 1, 0.5}, {4, 4, 6}}, {0.7}});
+  const double h = 1.0 / 27.0;  // the sponge 243 voxels high
+  nlohmann::json spec = {{"library", "menger_sponge"}, {"scale", 9.0}, {"translate_mm", {h / 2, h / 2, 8.0}}};
+  GeometrySet menger = cifs::attractor_geometry(cifs::parse_system(spec, "test", "system"), 2, {});
+  for (const auto& [what, volume] : {std::pair<std::string, Volume>{"sphere and tube", voxelize(set, VolumeOptions{0.06, 3.0})},
+                                     {"Menger sponge", voxelize(menger, VolumeOptions{h, 3.0})}}) {
+    SimplifyOptions options;
+    options.max_deviation_mm = 0.2 * volume.voxel_size_mm();
+    const TriMesh whole = extract_simplified_surface(volume, options);
+    Box3 box;
+    for (const Vec3d& p : whole.positions_mm) box.expand(p);
+    ASSERT_GE(box.size().z / volume.voxel_size_mm(), 6 * 32.0) << what << ": tall enough for three parts";
+    for (size_t parts : {2u, 3u}) {
+      const std::vector<StreamedPart> streamed = stream_parts(volume, options, box, parts);
+      // Concatenated, the parts' triangles are the whole surface's, corner for corner.
+      std::vector<std::array<Vec3d, 3>> corners;
+      std::vector<uint64_t> base{0};  // each part's numbers after the ones before
+      for (const StreamedPart& part : streamed) {
+        EXPECT_GE(part.emitted.batches, 1u) << what << ": every part emits";
+        corners.insert(corners.end(), part.emitted.corners.begin(), part.emitted.corners.end());
+        uint64_t top = 0;
+        for (const auto& n : part.emitted.numbers) top = std::max({top, n[0] + 1, n[1] + 1, n[2] + 1});
+        for (const auto& v : part.lead) top = std::max(top, v.number + 1);
+        for (const auto& v : part.tail) top = std::max(top, v.number + 1);
+        base.push_back(base.back() + top);
+      }
+      ASSERT_EQ(corners.size(), whole.triangles.size()) << what << ", " << parts << " parts";
+      size_t differ = 0;
+      for (size_t t = 0; t < whole.triangles.size(); ++t)
+        for (int k = 0; k < 3; ++k) differ += !(corners[t][size_t(k)] == whole.positions_mm[whole.triangles[t][size_t(k)]]);
+      EXPECT_EQ(differ, 0u) << what << ", " << parts << " parts";
+      // The numbers of neighbouring parts joined where the tail of one and the lead of the next
+      // name the same vertex: then each whole vertex is one class, and each class one whole vertex.
+      std::vector<uint64_t> parent(base.back());
+      std::iota(parent.begin(), parent.end(), uint64_t(0));
+      std::function<uint64_t(uint64_t)> find = [&](uint64_t a) { return parent[a] == a ? a : parent[a] = find(parent[a]); };
+      size_t joined = 0;
+      for (size_t p = 1; p < parts; ++p) {
+        std::map<std::array<uint64_t, 2>, uint64_t> tail;
+        for (const auto& v : streamed[p - 1].tail) tail[v.identity] = base[p - 1] + v.number;
+        for (const auto& v : streamed[p].lead) {
+          const auto it = tail.find(v.identity);
+          if (it == tail.end()) continue;
+          parent[find(it->second)] = find(base[p] + v.number);
+          ++joined;
+        }
+      }
+      EXPECT_GT(joined, 0u) << what;
+      std::map<uint32_t, uint64_t> class_of;  // whole vertex -> class
+      std::map<uint64_t, uint32_t> vertex_of;  // class -> whole vertex
+      size_t split = 0, merged = 0, t = 0;
+      for (size_t p = 0; p < parts; ++p)
+        for (const auto& n : streamed[p].emitted.numbers) {
+          for (int k = 0; k < 3; ++k) {
+            const uint32_t v = whole.triangles[t][size_t(k)];
+            const uint64_t c = find(base[p] + n[size_t(k)]);
+            auto [a, new_vertex] = class_of.try_emplace(v, c);
+            split += !new_vertex && a->second != c;
+            auto [b, new_class] = vertex_of.try_emplace(c, v);
+            merged += !new_class && b->second != v;
+          }
+          ++t;
+        }
+      EXPECT_EQ(split, 0u) << what << ", " << parts << " parts: a vertex in two classes";
+      EXPECT_EQ(merged, 0u) << what << ", " << parts << " parts: two vertices in one class";
+      EXPECT_EQ(class_of.size(), whole.positions_mm.size()) << what;
     }
   }
 }

@@ -60,12 +60,12 @@ void print_output_problems(const nlohmann::json& report) {
 
 // `lacuna run --stream`: every output streamed slab by slab into its STL, checked chunk by chunk.
 int command_stream(const std::string& recipe, const StreamOptions& options, const CommonFlags& flags) {
-  // One process writes a streamed mesh: under mpirun every rank would write the same folder.
-  const std::unique_ptr<SliceRanks> ranks = mpi_ranks();
-  if (ranks && ranks->size() > 1)
-    throw InvalidInput("--stream: a streamed mesh is written by one process (run it without mpirun; `lacuna slice` "
-                       "splits its slabs over MPI ranks)");
-  const StreamReport result = stream_recipe(recipe, options);
+  // Under mpirun: one rank of a job; the first prints what the job did.
+  const std::unique_ptr<JobRanks> ranks = mpi_ranks();
+  StreamOptions job = options;
+  job.ranks = ranks.get();
+  const StreamReport result = stream_recipe(recipe, job);
+  if (ranks && ranks->rank() != 0) return result.valid ? kExitOk : kExitCheckFailed;
   const nlohmann::json r = to_json(result);
   if (flags.json) std::cout << r.dump(2) << "\n";
   if (!result.valid) {
@@ -231,7 +231,7 @@ struct SliceArgs {
 int command_slice(SliceArgs args, const RunOptions& base, const CommonFlags& flags) {
   args.options.run = base;
   // Under mpirun: one rank of a job; the first prints what the job did.
-  const std::unique_ptr<SliceRanks> ranks = mpi_ranks();
+  const std::unique_ptr<JobRanks> ranks = mpi_ranks();
   args.options.ranks = ranks.get();
   const SliceReport report = slice_recipe(args.recipe, args.output, args.options);
   if (ranks && ranks->rank() != 0) return report.valid ? kExitOk : kExitCheckFailed;
@@ -382,7 +382,8 @@ int run_app(int argc, char** argv) {
   run_command->add_flag("--stream", stream,
                         "Stream the meshes: each object evaluated slab by slab along z and its surface written to\n"
                         "its STL as it comes, then checked chunk by chunk (memory follows the slab, not the part;\n"
-                        "STL outputs only, no printability); the same file as a whole run where that fits");
+                        "STL outputs only, no printability); the same file as a whole run where that fits.\n"
+                        "Under mpirun the processes split the slabs (the output's folder on a shared file system)");
   run_command->add_option("--slab-mm", stream_slab_mm,
                           "With --stream: slab height in mm, rounded up to blocks of 32 voxels (default: the whole part\n"
                           "when it fits the budget, otherwise the highest slabs that do)")

@@ -18,7 +18,7 @@ inline bool launched_by_mpirun() {
 
 // The job's ranks, MPI initialised until they are destroyed; null when mpirun did not start this
 // process. Throws InvalidInput when it did but this build has no MPI.
-std::unique_ptr<SliceRanks> mpi_ranks();
+std::unique_ptr<JobRanks> mpi_ranks();
 
 // Whether this build can run over MPI ranks.
 bool built_with_mpi();

@@ -75,48 +75,6 @@ const char* format_name(LayerFormat f) {
   return "";
 }
 
-// Runs one step of a job on every process, then lets every process know whether any failed: the
-// one that failed rethrows its error, the others stop with an error of the same kind naming it,
-// so the job ends everywhere with nothing written. Alone, just runs the step.
-template <typename Step>
-void in_every_rank(SliceRanks* ranks, Step&& step) {
-  if (!ranks) {
-    step();
-    return;
-  }
-  std::exception_ptr error;
-  int64_t kind = 0;  // 1 internal, 2 input, 3 files, 4 budget, 5 checks, 6 cancelled
-  try {
-    step();
-  } catch (const InvalidInput&) {
-    kind = 2, error = std::current_exception();
-  } catch (const IoError&) {
-    kind = 3, error = std::current_exception();
-  } catch (const ResourceLimit&) {
-    kind = 4, error = std::current_exception();
-  } catch (const CheckFailed&) {
-    kind = 5, error = std::current_exception();
-  } catch (const Cancelled&) {
-    kind = 6, error = std::current_exception();
-  } catch (...) {
-    kind = 1, error = std::current_exception();
-  }
-  // The worst kind, and among the processes with it the first.
-  const int64_t count = ranks->size();
-  const int64_t worst = ranks->max(kind == 0 ? 0 : kind * count + (count - 1 - ranks->rank()));
-  if (worst == 0) return;
-  if (error) std::rethrow_exception(error);
-  const std::string message = "process " + std::to_string(count - 1 - worst % count) + " of " + std::to_string(count) +
-                              " failed (its message says why); this one stopped with it and nothing was written";
-  switch (worst / count) {
-    case 2: throw InvalidInput(message);
-    case 3: throw IoError(message);
-    case 4: throw ResourceLimit(message);
-    case 5: throw CheckFailed(message);
-    case 6: throw Cancelled(message);
-    default: throw InternalError(message);
-  }
-}
 
 // Length-prefixed texts in one string (what processes hand each other).
 void append_text(std::string& out, const std::string& text) {
@@ -486,7 +444,7 @@ SliceReport slice_recipe(Recipe recipe, const std::string& output, const SliceOp
   // A job over several processes: each takes a block of the slabs (split into as many as there are
   // processes, when the part is that many leaves high, if the whole would fit one). They agree on
   // the budget (the least of theirs), so that they cut the same slabs.
-  SliceRanks* ranks = options.ranks && options.ranks->size() > 1 ? options.ranks : nullptr;
+  JobRanks* ranks = options.ranks && options.ranks->size() > 1 ? options.ranks : nullptr;
   const int rank_count = ranks ? ranks->size() : 1, me = ranks ? ranks->rank() : 0;
   uint64_t budget = options.run.max_memory_bytes ? options.run.max_memory_bytes : available_memory_bytes() / 2;
   if (ranks) budget = uint64_t(ranks->min(double(budget)));

@@ -14,6 +14,7 @@
 #include "export/zip_archive.h"
 #include "layers/layers.h"
 #include "pipeline/pipeline.h"
+#include "pipeline/ranks.h"
 #include "recipe/recipe.h"
 #include "solids/volume.h"
 #include "util/progress.h"
@@ -39,7 +40,7 @@ struct SliceOptions {
   double slab_mm = 0;
   // A job over several processes (the same call in each): their ranks; null or one alone: this
   // process does everything. The files are the same bytes as one process's.
-  class SliceRanks* ranks = nullptr;
+  JobRanks* ranks = nullptr;
   RunOptions run;             // voxel size, budget, threads, progress
 };
 
@@ -129,19 +130,6 @@ class LayerSlicer {
   std::unique_ptr<Progress> bar_;
 };
 
-// The processes of one job (MPI ranks, see src/cli/mpi_ranks.h): each evaluates a block of the slabs
-// and cuts the layers whose planes lie in them; the first gathers what they found and writes.
-class SliceRanks {
- public:
-  virtual ~SliceRanks() = default;
-  virtual int rank() const = 0;
-  virtual int size() const = 0;
-  // Over every process (each must call them in the same order).
-  virtual double min(double value) = 0;
-  virtual int64_t max(int64_t value) = 0;
-  // The first process gets every process's bytes in rank order, the others nothing.
-  virtual std::vector<std::string> gather(const std::string& bytes) = 0;
-};
 
 // Cuts `volume` into layers and checks them (the report is not valid when a layer failed), the
 // pixel grid over `planned_box` when given (an evaluation's ObjectExtent, as `lacuna slice` uses),

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "pipeline/pipeline.h"
+#include "pipeline/ranks.h"
 #include "recipe/recipe.h"
 #include "solids/check.h"
 
@@ -22,6 +23,11 @@ struct StreamOptions {
   // level set fits the budget, otherwise the highest slabs that do.
   double slab_mm = 0;
   RunOptions run;  // output folder, voxel size, simplification, budget, threads, progress, report
+  // A job over several processes (the same call in each, `mpirun -np K lacuna run --stream`): each
+  // streams a block of the slabs into a part beside the output (a file system they share), the
+  // first joins the parts, checks the file and writes; the file is the same bytes as one process's.
+  // Null or one alone: this process does everything. Only the first's report has figures.
+  JobRanks* ranks = nullptr;
 };
 
 struct StreamedOutput {

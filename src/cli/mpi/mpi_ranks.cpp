@@ -10,7 +10,7 @@
 namespace lacuna {
 namespace {
 
-class MpiRanks : public SliceRanks {
+class MpiRanks : public JobRanks {
  public:
   MpiRanks() {
     int provided = 0;
@@ -66,7 +66,7 @@ class MpiRanks : public SliceRanks {
 
 }  // namespace
 
-std::unique_ptr<SliceRanks> mpi_ranks() {
+std::unique_ptr<JobRanks> mpi_ranks() {
   if (!launched_by_mpirun()) return nullptr;
   return std::make_unique<MpiRanks>();
 }

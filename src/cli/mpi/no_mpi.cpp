@@ -5,7 +5,7 @@
 
 namespace lacuna {
 
-std::unique_ptr<SliceRanks> mpi_ranks() {
+std::unique_ptr<JobRanks> mpi_ranks() {
   if (launched_by_mpirun())
     throw InvalidInput("started by mpirun, but this lacuna was built without MPI (install libopenmpi-dev and "
                        "rebuild, or run it alone)");
