@@ -8,6 +8,8 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <numeric>
 #include <unordered_map>
 
@@ -15,6 +17,7 @@
 #include "solids/components.h"
 #include "solids/exact.h"
 #include "solids/mesh_topology.h"
+#include "util/buffer.h"
 #include "util/progress.h"
 
 namespace lacuna {
@@ -166,13 +169,23 @@ struct FaceBox {
   float lo[3], hi[3];
 };
 
+// The float next to a finite or infinite f towards -inf or +inf: a step of its bit pattern (what
+// std::nextafter does, inline: it runs six times for every face).
+float next_float(float f, bool above) {
+  if (f == 0) return above ? std::numeric_limits<float>::denorm_min() : -std::numeric_limits<float>::denorm_min();
+  uint32_t bits;
+  std::memcpy(&bits, &f, sizeof bits);
+  bits += (f > 0) == above ? 1 : uint32_t(-1);
+  std::memcpy(&f, &bits, sizeof f);
+  return f;
+}
 float down(double v) {
-  float f = float(v);
-  return double(f) > v ? std::nextafter(f, -HUGE_VALF) : f;
+  const float f = float(v);
+  return double(f) > v ? next_float(f, false) : f;
 }
 float up(double v) {
-  float f = float(v);
-  return double(f) < v ? std::nextafter(f, HUGE_VALF) : f;
+  const float f = float(v);
+  return double(f) < v ? next_float(f, true) : f;
 }
 
 // Whether any two faces meet other than in the vertices or edge they share (exact predicates).
@@ -195,7 +208,7 @@ bool self_intersects(const TriMesh& mesh, const EdgeTopology& edges, const Verte
       if (corners.degree(uint32_t(v)) > 0)
         graph_fan[v] = fan_is_graph(mesh, edges, corners.corners[corners.offsets[v]], uint32_t(v));
   });
-  std::vector<FaceBox> boxes(nf);
+  Buffer<FaceBox> boxes(nf);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nf, 8192), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t f = range.begin(); f != range.end(); ++f) {
       const auto& t = mesh.triangles[f];
@@ -281,15 +294,21 @@ bool self_intersects(const TriMesh& mesh, const EdgeTopology& edges, const Verte
         for (int64_t z = z0; z <= z1; ++z) visit(size_t((x * dims[1] + y) * dims[2] + z));
   };
   // Counting sort of (cell, face) entries; the order inside a cell does not matter.
-  std::vector<uint32_t> start(ncells + 1, 0);
+  Buffer<uint32_t> start(ncells + 1);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, ncells + 1, 65536), [&](const tbb::blocked_range<size_t>& range) {
+    std::fill(start.data() + range.begin(), start.data() + range.end(), 0u);
+  });
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nf, 8192), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t f = range.begin(); f != range.end(); ++f)
       if (!skip[f]) for_cells(f, [&](size_t c) { __atomic_fetch_add(&start[c + 1], 1u, __ATOMIC_RELAXED); });
   });
   for (size_t c = 0; c < ncells; ++c) start[c + 1] += start[c];
-  std::vector<uint32_t> entries(start[ncells]);
+  Buffer<uint32_t> entries(start[ncells]);
   {
-    std::vector<uint32_t> cursor(start.begin(), start.end() - 1);
+    Buffer<uint32_t> cursor(ncells);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, ncells, 65536), [&](const tbb::blocked_range<size_t>& range) {
+      std::copy(start.data() + range.begin(), start.data() + range.end(), cursor.data() + range.begin());
+    });
     tbb::parallel_for(tbb::blocked_range<size_t>(0, nf, 8192), [&](const tbb::blocked_range<size_t>& range) {
       for (size_t f = range.begin(); f != range.end(); ++f)
         if (!skip[f])
@@ -302,10 +321,10 @@ bool self_intersects(const TriMesh& mesh, const EdgeTopology& edges, const Verte
   // Each cell's faces are gathered once into a local list, so the pair loop reads nothing else.
   struct Local {
     FaceBox box;
-    std::array<int32_t, 3> low;
     std::array<uint32_t, 3> v;
-    uint32_t graph_fans;  // bit k: v[k] has a graph fan
     uint32_t face;
+    uint8_t graph_fans;  // bit k: v[k] has a graph fan
+    uint8_t starts_here;  // bit k: the box starts in this cell's slice along axis k
   };
   tbb::parallel_for(size_t(0), chunks, [&](size_t chunk) {
     const size_t c0 = ncells * chunk / chunks, c1 = ncells * (chunk + 1) / chunks;
@@ -316,16 +335,17 @@ bool self_intersects(const TriMesh& mesh, const EdgeTopology& edges, const Verte
         const size_t n = start[c + 1] - start[c];
         if (n < 2) continue;
         const int64_t cz = int64_t(c) % dims[2], cy = (int64_t(c) / dims[2]) % dims[1], cx = int64_t(c) / (dims[1] * dims[2]);
-        const int32_t here[3] = {int32_t(cx), int32_t(cy), int32_t(cz)};
+        const int64_t here[3] = {cx, cy, cz};
         local.resize(n);
         for (size_t i = 0; i < n; ++i) {
           const uint32_t f = list[i];
           const auto& t = mesh.triangles[f];
-          // The cell of the box's lowest corner: the overlap of two boxes starts in the larger of theirs.
-          const std::array<int32_t, 3> low{int32_t(cell_of(boxes[f].lo[0], 0)), int32_t(cell_of(boxes[f].lo[1], 1)),
-                                           int32_t(cell_of(boxes[f].lo[2], 2))};
-          local[i] = {boxes[f], low, t,
-                      uint32_t(graph_fan[t[0]]) | uint32_t(graph_fan[t[1]]) << 1 | uint32_t(graph_fan[t[2]]) << 2, f};
+          // The cell of the box's lowest corner; the overlap of two boxes starts in the larger of
+          // theirs, and neither starts beyond this cell (both are listed in it), so the overlap starts
+          // here exactly when, along every axis, one of the two starts here.
+          uint8_t starts_here = 0;
+          for (int k = 0; k < 3; ++k) starts_here |= uint8_t((cell_of(boxes[f].lo[k], k) == here[k]) << k);
+          local[i] = {boxes[f], t, f, uint8_t(graph_fan[t[0]] | graph_fan[t[1]] << 1 | graph_fan[t[2]] << 2), starts_here};
         }
         // By the boxes' lower x, so each face meets only the run of faces that start before it ends.
         std::sort(local.begin(), local.end(), [](const Local& a, const Local& b) {
@@ -335,16 +355,14 @@ bool self_intersects(const TriMesh& mesh, const EdgeTopology& edges, const Verte
           const Local& a = local[i];
           for (size_t j = i + 1; j < n && local[j].box.lo[0] <= a.box.hi[0]; ++j) {
             const Local& b = local[j];
-            if (!(a.box.lo[1] <= b.box.hi[1] && b.box.lo[1] <= a.box.hi[1] && a.box.lo[2] <= b.box.hi[2] &&
-                  b.box.lo[2] <= a.box.hi[2]))
-              continue;
-            if (std::max(a.low[0], b.low[0]) != here[0] || std::max(a.low[1], b.low[1]) != here[1] ||
-                std::max(a.low[2], b.low[2]) != here[2])
-              continue;
+            // Without branches between the tests: most pairs fail one of them, unpredictably.
+            const bool overlap = (a.box.lo[1] <= b.box.hi[1]) & (b.box.lo[1] <= a.box.hi[1]) &
+                                 (a.box.lo[2] <= b.box.hi[2]) & (b.box.lo[2] <= a.box.hi[2]);
+            if (!(overlap & ((a.starts_here | b.starts_here) == 7))) continue;
             bool in_graph_fan = false;
             for (int k = 0; k < 3; ++k)
-              if ((a.graph_fans >> k & 1) && (a.v[size_t(k)] == b.v[0] || a.v[size_t(k)] == b.v[1] || a.v[size_t(k)] == b.v[2]))
-                in_graph_fan = true;
+              in_graph_fan |= bool(a.graph_fans >> k & 1) &
+                              ((a.v[size_t(k)] == b.v[0]) | (a.v[size_t(k)] == b.v[1]) | (a.v[size_t(k)] == b.v[2]));
             if (in_graph_fan) continue;
             if (exact::faces_intersect(mesh.positions_mm.data(), a.v, b.v)) {
               hit = true;

@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <stdexcept>
 
-#include "solids/disjoint_sets.h"
 
 namespace lacuna {
 
@@ -18,7 +17,10 @@ EdgeTopology edge_topology(const TriMesh& mesh, const VertexCorners& corners, bo
   const size_t nv = mesh.positions_mm.size(), nh = 3 * mesh.triangles.size();
   if (nh >= UINT32_MAX) throw std::length_error("a mesh with more than 1.4 billion triangles");
   EdgeTopology r;
-  r.opposite.assign(nh, kNoHalfEdge);
+  r.opposite = Buffer<uint32_t>(nh);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nh, 65536), [&](const tbb::blocked_range<size_t>& range) {
+    std::fill(r.opposite.data() + range.begin(), r.opposite.data() + range.end(), kNoHalfEdge);
+  });
   r.low_edges.assign(nv, 0);
   if (with_partners) r.partner.assign(nh, kNoHalfEdge);
   struct Counts {
@@ -94,23 +96,29 @@ VertexCorners vertex_corners(const TriMesh& mesh) {
   // corners sorted (so the result is the same for any number of threads).
   VertexCorners r;
   const size_t nv = mesh.positions_mm.size(), nc = 3 * mesh.triangles.size();
-  std::vector<uint32_t> count(nv + 1, 0);
+  Buffer<uint32_t> count(nv + 1);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv + 1, 65536), [&](const tbb::blocked_range<size_t>& range) {
+    std::fill(count.data() + range.begin(), count.data() + range.end(), 0u);
+  });
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nc, 16384), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t c = range.begin(); c != range.end(); ++c)
       __atomic_fetch_add(&count[mesh.triangles[c / 3][c % 3] + 1], 1u, __ATOMIC_RELAXED);
   });
-  r.offsets.resize(nv + 1);
+  r.offsets = Buffer<uint64_t>(nv + 1);
   r.offsets[0] = 0;
   for (size_t v = 0; v < nv; ++v) r.offsets[v + 1] = r.offsets[v] + count[v + 1];
-  r.corners.resize(nc);
-  std::vector<uint64_t> cursor(r.offsets.begin(), r.offsets.end() - 1);
+  r.corners = Buffer<uint32_t>(nc);
+  Buffer<uint64_t> cursor(nv);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 65536), [&](const tbb::blocked_range<size_t>& range) {
+    std::copy(r.offsets.data() + range.begin(), r.offsets.data() + range.end(), cursor.data() + range.begin());
+  });
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nc, 16384), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t c = range.begin(); c != range.end(); ++c)
       r.corners[__atomic_fetch_add(&cursor[mesh.triangles[c / 3][c % 3]], uint64_t{1}, __ATOMIC_RELAXED)] = uint32_t(c);
   });
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 8192), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t v = range.begin(); v != range.end(); ++v)
-      std::sort(r.corners.begin() + int64_t(r.offsets[v]), r.corners.begin() + int64_t(r.offsets[v + 1]));
+      std::sort(r.corners.data() + r.offsets[v], r.corners.data() + r.offsets[v + 1]);
   });
   return r;
 }
@@ -185,23 +193,73 @@ std::vector<std::vector<uint32_t>> boundary_loops(const TriMesh& mesh, const Edg
 }
 
 VertexComponents vertex_components(const TriMesh& mesh) {
-  const size_t nv = mesh.positions_mm.size();
-  DisjointSets sets(nv);
-  std::vector<uint8_t> used(nv, 0);
-  for (const auto& t : mesh.triangles) {
-    sets.join(t[0], t[1]);
-    sets.join(t[1], t[2]);
-    used[t[0]] = used[t[1]] = used[t[2]] = 1;
-  }
+  // Union-find joined concurrently: a root is linked only to a smaller root (by compare-and-swap,
+  // retried when another join moved it first), so every set ends with its smallest vertex as root
+  // whatever the order of the joins; the components are then numbered in order of their roots.
+  const size_t nv = mesh.positions_mm.size(), nf = mesh.triangles.size();
+  Buffer<uint32_t> parent(nv);
+  Buffer<uint8_t> used(nv);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 65536), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t v = range.begin(); v != range.end(); ++v) {
+      parent[v] = uint32_t(v);
+      used[v] = 0;
+    }
+  });
+  auto load = [&](uint32_t v) { return __atomic_load_n(&parent[v], __ATOMIC_RELAXED); };
+  auto find = [&](uint32_t v) {
+    for (;;) {
+      const uint32_t p = load(v);
+      if (p == v) return v;
+      const uint32_t g = load(p);
+      uint32_t expected = p;
+      if (g != p)  // path halving; losing the race to another join leaves a valid ancestor either way
+        __atomic_compare_exchange_n(&parent[v], &expected, g, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED);
+      v = g;
+    }
+  };
+  auto join = [&](uint32_t a, uint32_t b) {
+    for (;;) {
+      a = find(a);
+      b = find(b);
+      if (a == b) return;
+      if (a < b) std::swap(a, b);
+      uint32_t expected = a;
+      if (__atomic_compare_exchange_n(&parent[a], &expected, b, false, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) return;
+    }
+  };
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nf, 16384), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t f = range.begin(); f != range.end(); ++f) {
+      const auto& t = mesh.triangles[f];
+      join(t[0], t[1]);
+      join(t[1], t[2]);
+      for (uint32_t v : t) __atomic_store_n(&used[v], uint8_t{1}, __ATOMIC_RELAXED);
+    }
+  });
+  // Every vertex straight to its root; the roots of used vertices counted in fixed blocks.
+  const size_t blocks = nv / 65536 + 1;
+  std::vector<uint32_t> roots(blocks + 1, 0);
+  tbb::parallel_for(size_t(0), blocks, [&](size_t block) {
+    uint32_t n = 0;
+    for (size_t v = nv * block / blocks; v < nv * (block + 1) / blocks; ++v) {
+      parent[v] = find(uint32_t(v));
+      n += used[v] && parent[v] == v;
+    }
+    roots[block + 1] = n;
+  });
+  for (size_t block = 0; block < blocks; ++block) roots[block + 1] += roots[block];
   VertexComponents r;
-  r.of_vertex.assign(nv, UINT32_MAX);
-  std::vector<uint32_t> of_root(nv, UINT32_MAX);
-  for (size_t v = 0; v < nv; ++v) {
-    if (!used[v]) continue;
-    const uint32_t root = sets.find(uint32_t(v));
-    if (of_root[root] == UINT32_MAX) of_root[root] = r.count++;
-    r.of_vertex[v] = of_root[root];
-  }
+  r.count = roots[blocks];
+  r.of_vertex.resize(nv);
+  tbb::parallel_for(size_t(0), blocks, [&](size_t block) {
+    uint32_t next = roots[block];
+    for (size_t v = nv * block / blocks; v < nv * (block + 1) / blocks; ++v)
+      r.of_vertex[v] = used[v] && parent[v] == v ? next++ : UINT32_MAX;
+  });
+  // A root is its set's smallest vertex: numbered above before any vertex of its set is read here.
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 65536), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t v = range.begin(); v != range.end(); ++v)
+      if (used[v] && parent[v] != v) r.of_vertex[v] = r.of_vertex[parent[v]];
+  });
   return r;
 }
 

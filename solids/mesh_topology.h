@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "geometry.h"
+#include "util/buffer.h"
 
 namespace lacuna {
 
@@ -23,7 +24,7 @@ inline uint32_t next_half_edge(uint32_t h) { return 3 * (h / 3) + (h % 3 + 1) % 
 struct EdgeTopology {
   // The half-edge running the same edge the other way, when exactly two faces share the edge and
   // run it in opposite directions; kNoHalfEdge otherwise.
-  std::vector<uint32_t> opposite;
+  Buffer<uint32_t> opposite;
   uint64_t edges = 0;               // distinct undirected edges (edges of repeated-corner faces aside)
   uint64_t boundary_edges = 0;      // one face
   uint64_t non_manifold_edges = 0;  // more than two faces
@@ -41,8 +42,8 @@ struct EdgeTopology {
 
 // The corners (3 * f + k) at every vertex: corners[offsets[v] .. offsets[v + 1]) in increasing order.
 struct VertexCorners {
-  std::vector<uint64_t> offsets;
-  std::vector<uint32_t> corners;
+  Buffer<uint64_t> offsets;
+  Buffer<uint32_t> corners;
   uint32_t degree(uint32_t v) const { return uint32_t(offsets[v + 1] - offsets[v]); }
 };
 VertexCorners vertex_corners(const TriMesh& mesh);
