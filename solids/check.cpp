@@ -208,17 +208,19 @@ bool self_intersects(const TriMesh& mesh, const EdgeTopology& edges, const Verte
       if (corners.degree(uint32_t(v)) > 0)
         graph_fan[v] = fan_is_graph(mesh, edges, corners.corners[corners.offsets[v]], uint32_t(v));
   });
-  Buffer<FaceBox> boxes(nf);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, nf, 8192), [&](const tbb::blocked_range<size_t>& range) {
-    for (size_t f = range.begin(); f != range.end(); ++f) {
-      const auto& t = mesh.triangles[f];
-      for (int k = 0; k < 3; ++k) {
-        const double a = mesh.positions_mm[t[0]][k], b = mesh.positions_mm[t[1]][k], c = mesh.positions_mm[t[2]][k];
-        boxes[f].lo[k] = down(std::min({a, b, c}));
-        boxes[f].hi[k] = up(std::max({a, b, c}));
-      }
+  // A face's box, made again where it is needed: cheaper than the fresh pages a stored box for every
+  // face takes (measured on 18.65 M faces: the self-intersection pass 4.6 s -> 4.2 s, the check's
+  // peak 1.83 GB -> 1.39 GB).
+  auto box_of = [&](size_t f) {
+    const auto& t = mesh.triangles[f];
+    const Vec3d &p0 = mesh.positions_mm[t[0]], &p1 = mesh.positions_mm[t[1]], &p2 = mesh.positions_mm[t[2]];
+    FaceBox b;
+    for (int k = 0; k < 3; ++k) {
+      b.lo[k] = down(std::min({p0[k], p1[k], p2[k]}));
+      b.hi[k] = up(std::max({p0[k], p1[k], p2[k]}));
     }
-  });
+    return b;
+  };
   // The boxes' extent and twice the area, in fixed blocks (the sum does not depend on the threads).
   struct Extent {
     double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
@@ -229,9 +231,10 @@ bool self_intersects(const TriMesh& mesh, const EdgeTopology& edges, const Verte
   tbb::parallel_for(size_t(0), extent_blocks, [&](size_t block) {
     Extent& e = extents[block];
     for (size_t f = nf * block / extent_blocks; f < nf * (block + 1) / extent_blocks; ++f) {
+      const FaceBox b = box_of(f);
       for (int k = 0; k < 3; ++k) {
-        e.lo[k] = std::min(e.lo[k], double(boxes[f].lo[k]));
-        e.hi[k] = std::max(e.hi[k], double(boxes[f].hi[k]));
+        e.lo[k] = std::min(e.lo[k], double(b.lo[k]));
+        e.hi[k] = std::max(e.hi[k], double(b.hi[k]));
       }
       const auto& t = mesh.triangles[f];
       e.area2 += norm(cross(mesh.positions_mm[t[1]] - mesh.positions_mm[t[0]], mesh.positions_mm[t[2]] - mesh.positions_mm[t[0]]));
@@ -271,8 +274,9 @@ bool self_intersects(const TriMesh& mesh, const EdgeTopology& edges, const Verte
         tbb::blocked_range<size_t>(0, nf, 8192), uint64_t{0},
         [&](const tbb::blocked_range<size_t>& range, uint64_t n) {
           for (size_t f = range.begin(); f != range.end(); ++f) {
+            const FaceBox b = box_of(f);
             uint64_t m = 1;
-            for (int k = 0; k < 3; ++k) m *= uint64_t(cell_of(boxes[f].hi[k], k) - cell_of(boxes[f].lo[k], k) + 1);
+            for (int k = 0; k < 3; ++k) m *= uint64_t(cell_of(b.hi[k], k) - cell_of(b.lo[k], k) + 1);
             n += m;
           }
           return n;
@@ -286,7 +290,7 @@ bool self_intersects(const TriMesh& mesh, const EdgeTopology& edges, const Verte
   }
   const size_t ncells = size_t(dims[0] * dims[1] * dims[2]);
   auto for_cells = [&](size_t f, auto&& visit) {
-    const FaceBox& b = boxes[f];
+    const FaceBox b = box_of(f);
     const int64_t x0 = cell_of(b.lo[0], 0), x1 = cell_of(b.hi[0], 0), y0 = cell_of(b.lo[1], 1),
                   y1 = cell_of(b.hi[1], 1), z0 = cell_of(b.lo[2], 2), z1 = cell_of(b.hi[2], 2);
     for (int64_t x = x0; x <= x1; ++x)
@@ -330,6 +334,7 @@ bool self_intersects(const TriMesh& mesh, const EdgeTopology& edges, const Verte
     const size_t c0 = ncells * chunk / chunks, c1 = ncells * (chunk + 1) / chunks;
     tbb::parallel_for(tbb::blocked_range<size_t>(c0, c1, 1024), [&](const tbb::blocked_range<size_t>& range) {
       std::vector<Local> local;
+      std::vector<uint32_t> candidates;
       for (size_t c = range.begin(); c != range.end() && !hit.load(std::memory_order_relaxed); ++c) {
         const uint32_t* list = entries.data() + start[c];
         const size_t n = start[c + 1] - start[c];
@@ -344,31 +349,37 @@ bool self_intersects(const TriMesh& mesh, const EdgeTopology& edges, const Verte
           // theirs, and neither starts beyond this cell (both are listed in it), so the overlap starts
           // here exactly when, along every axis, one of the two starts here.
           uint8_t starts_here = 0;
-          for (int k = 0; k < 3; ++k) starts_here |= uint8_t((cell_of(boxes[f].lo[k], k) == here[k]) << k);
-          local[i] = {boxes[f], t, f, uint8_t(graph_fan[t[0]] | graph_fan[t[1]] << 1 | graph_fan[t[2]] << 2), starts_here};
+          const FaceBox box = box_of(f);
+          for (int k = 0; k < 3; ++k) starts_here |= uint8_t((cell_of(box.lo[k], k) == here[k]) << k);
+          local[i] = {box, t, f, uint8_t(graph_fan[t[0]] | graph_fan[t[1]] << 1 | graph_fan[t[2]] << 2), starts_here};
         }
         // By the boxes' lower x, so each face meets only the run of faces that start before it ends.
         std::sort(local.begin(), local.end(), [](const Local& a, const Local& b) {
           return a.box.lo[0] != b.box.lo[0] ? a.box.lo[0] < b.box.lo[0] : a.face < b.face;
         });
+        candidates.resize(n);
         for (size_t i = 0; i + 1 < n; ++i) {
           const Local& a = local[i];
+          // The faces after a whose boxes meet a's and whose overlap starts in this cell, and that
+          // share no vertex with a graph fan with a, listed without a branch per face (most fail one
+          // of the tests, unpredictably): each is written and kept only when it passed.
+          size_t kept = 0;
           for (size_t j = i + 1; j < n && local[j].box.lo[0] <= a.box.hi[0]; ++j) {
             const Local& b = local[j];
-            // Without branches between the tests: most pairs fail one of them, unpredictably.
             const bool overlap = (a.box.lo[1] <= b.box.hi[1]) & (b.box.lo[1] <= a.box.hi[1]) &
                                  (a.box.lo[2] <= b.box.hi[2]) & (b.box.lo[2] <= a.box.hi[2]);
-            if (!(overlap & ((a.starts_here | b.starts_here) == 7))) continue;
             bool in_graph_fan = false;
             for (int k = 0; k < 3; ++k)
               in_graph_fan |= bool(a.graph_fans >> k & 1) &
                               ((a.v[size_t(k)] == b.v[0]) | (a.v[size_t(k)] == b.v[1]) | (a.v[size_t(k)] == b.v[2]));
-            if (in_graph_fan) continue;
-            if (exact::faces_intersect(mesh.positions_mm.data(), a.v, b.v)) {
+            candidates[kept] = uint32_t(j);
+            kept += size_t(overlap & ((a.starts_here | b.starts_here) == 7) & !in_graph_fan);
+          }
+          for (size_t q = 0; q < kept; ++q)
+            if (exact::faces_intersect(mesh.positions_mm.data(), a.v, local[candidates[q]].v)) {
               hit = true;
               return;
             }
-          }
         }
       }
     });
