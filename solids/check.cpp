@@ -17,7 +17,7 @@
 #include "solids/components.h"
 #include "solids/exact.h"
 #include "solids/mesh_topology.h"
-#include "util/buffer.h"
+#include "solids/parallel_buffer.h"
 #include "util/progress.h"
 
 namespace lacuna {
@@ -298,10 +298,7 @@ bool self_intersects(const TriMesh& mesh, const EdgeTopology& edges, const Verte
         for (int64_t z = z0; z <= z1; ++z) visit(size_t((x * dims[1] + y) * dims[2] + z));
   };
   // Counting sort of (cell, face) entries; the order inside a cell does not matter.
-  Buffer<uint32_t> start(ncells + 1);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, ncells + 1, 65536), [&](const tbb::blocked_range<size_t>& range) {
-    std::fill(start.data() + range.begin(), start.data() + range.end(), 0u);
-  });
+  Buffer<uint32_t> start = filled_buffer(ncells + 1, 0u);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nf, 8192), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t f = range.begin(); f != range.end(); ++f)
       if (!skip[f]) for_cells(f, [&](size_t c) { __atomic_fetch_add(&start[c + 1], 1u, __ATOMIC_RELAXED); });
@@ -309,10 +306,7 @@ bool self_intersects(const TriMesh& mesh, const EdgeTopology& edges, const Verte
   for (size_t c = 0; c < ncells; ++c) start[c + 1] += start[c];
   Buffer<uint32_t> entries(start[ncells]);
   {
-    Buffer<uint32_t> cursor(ncells);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, ncells, 65536), [&](const tbb::blocked_range<size_t>& range) {
-      std::copy(start.data() + range.begin(), start.data() + range.end(), cursor.data() + range.begin());
-    });
+    Buffer<uint32_t> cursor = copied_buffer(start.data(), ncells);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, nf, 8192), [&](const tbb::blocked_range<size_t>& range) {
       for (size_t f = range.begin(); f != range.end(); ++f)
         if (!skip[f])

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "solids/parallel_buffer.h"
 
 namespace lacuna {
 
@@ -17,10 +18,7 @@ EdgeTopology edge_topology(const TriMesh& mesh, const VertexCorners& corners, bo
   const size_t nv = mesh.positions_mm.size(), nh = 3 * mesh.triangles.size();
   if (nh >= UINT32_MAX) throw std::length_error("a mesh with more than 1.4 billion triangles");
   EdgeTopology r;
-  r.opposite = Buffer<uint32_t>(nh);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, nh, 65536), [&](const tbb::blocked_range<size_t>& range) {
-    std::fill(r.opposite.data() + range.begin(), r.opposite.data() + range.end(), kNoHalfEdge);
-  });
+  r.opposite = filled_buffer(nh, kNoHalfEdge);
   r.low_edges.assign(nv, 0);
   if (with_partners) r.partner.assign(nh, kNoHalfEdge);
   struct Counts {
@@ -96,10 +94,7 @@ VertexCorners vertex_corners(const TriMesh& mesh) {
   // corners sorted (so the result is the same for any number of threads).
   VertexCorners r;
   const size_t nv = mesh.positions_mm.size(), nc = 3 * mesh.triangles.size();
-  Buffer<uint32_t> count(nv + 1);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv + 1, 65536), [&](const tbb::blocked_range<size_t>& range) {
-    std::fill(count.data() + range.begin(), count.data() + range.end(), 0u);
-  });
+  Buffer<uint32_t> count = filled_buffer(nv + 1, 0u);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nc, 16384), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t c = range.begin(); c != range.end(); ++c)
       __atomic_fetch_add(&count[mesh.triangles[c / 3][c % 3] + 1], 1u, __ATOMIC_RELAXED);
@@ -108,10 +103,7 @@ VertexCorners vertex_corners(const TriMesh& mesh) {
   r.offsets[0] = 0;
   for (size_t v = 0; v < nv; ++v) r.offsets[v + 1] = r.offsets[v] + count[v + 1];
   r.corners = Buffer<uint32_t>(nc);
-  Buffer<uint64_t> cursor(nv);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 65536), [&](const tbb::blocked_range<size_t>& range) {
-    std::copy(r.offsets.data() + range.begin(), r.offsets.data() + range.end(), cursor.data() + range.begin());
-  });
+  Buffer<uint64_t> cursor = copied_buffer(r.offsets.data(), nv);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nc, 16384), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t c = range.begin(); c != range.end(); ++c)
       r.corners[__atomic_fetch_add(&cursor[mesh.triangles[c / 3][c % 3]], uint64_t{1}, __ATOMIC_RELAXED)] = uint32_t(c);
@@ -241,8 +233,9 @@ VertexComponents vertex_components(const TriMesh& mesh) {
   tbb::parallel_for(size_t(0), blocks, [&](size_t block) {
     uint32_t n = 0;
     for (size_t v = nv * block / blocks; v < nv * (block + 1) / blocks; ++v) {
-      parent[v] = find(uint32_t(v));
-      n += used[v] && parent[v] == v;
+      const uint32_t root = find(uint32_t(v));
+      __atomic_store_n(&parent[v], root, __ATOMIC_RELAXED);  // other threads' finds read it
+      n += used[v] && root == v;
     }
     roots[block + 1] = n;
   });
