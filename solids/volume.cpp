@@ -233,18 +233,36 @@ Volume intersect(const Volume& a, const Volume& b) {
   return wrap_grid(openvdb::tools::csgIntersectionCopy(*a.impl().grid, *b.impl().grid), a.options());
 }
 
-Volume offset(const Volume& v, double distance_mm) {
-  if (!std::isfinite(distance_mm)) throw InvalidInput("offset distance must be a finite length in mm");
-  if (distance_mm == 0 || v.empty()) return v;
-  // Exact Euclidean offset: distances to the extracted surface over a band wide enough to hold
-  // the moved surface, then shifted. (Re-distancing a narrow band with LevelSetFilter::offset or
+Volume offset(const Volume& v, double distance_mm) { return offsets(v, {distance_mm}).front(); }
+
+std::vector<Volume> offsets(const Volume& v, const std::vector<double>& distances_mm) {
+  double outside = 0, inside = 0;
+  for (double d : distances_mm) {
+    if (!std::isfinite(d)) throw InvalidInput("offset distance must be a finite length in mm");
+    outside = std::max(outside, d);
+    inside = std::max(inside, -d);
+  }
+  std::vector<Volume> result(distances_mm.size(), v);
+  if (v.empty() || (outside == 0 && inside == 0)) return result;
+  // Exact Euclidean offsets: distances to the extracted surface over a band wide enough to hold
+  // every moved surface, then shifted. (Re-distancing a narrow band with LevelSetFilter::offset or
   // levelSetRebuild was 30-50x slower on OpenVDB 10; see README.)
-  TriMesh surface = extract_surface(v);
   const double band = v.band_mm();
-  auto grid = mesh_distance(surface, v.voxel_size_mm(), std::max(distance_mm, 0.0) + band,
-                            std::max(-distance_mm, 0.0) + band, "offset");
-  rebuild_band(*grid, static_cast<float>(distance_mm), static_cast<float>(band));
-  return wrap_grid(grid, v.options());
+  openvdb::FloatGrid::Ptr distance;
+  {
+    TriMesh surface = extract_surface(v);
+    distance = mesh_distance(surface, v.voxel_size_mm(), outside + band, inside + band, "offset");
+  }
+  // The last offset that needs the distances shifts them in place; the others shift copies.
+  size_t last = distances_mm.size();
+  while (distances_mm[last - 1] == 0) --last;
+  for (size_t i = 0; i < distances_mm.size(); ++i) {
+    if (distances_mm[i] == 0) continue;
+    openvdb::FloatGrid::Ptr grid = i + 1 == last ? distance : distance->deepCopy();
+    rebuild_band(*grid, static_cast<float>(distances_mm[i]), static_cast<float>(band));
+    result[i] = wrap_grid(grid, v.options());
+  }
+  return result;
 }
 
 Volume shell(const Volume& v, double thickness_mm) {

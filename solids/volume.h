@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "geometry.h"
 
@@ -55,6 +56,11 @@ Volume intersect(const Volume& a, const Volume& b);
 
 // Grows (distance > 0) or shrinks (distance < 0) the solid by a Euclidean distance in mm.
 Volume offset(const Volume& v, double distance_mm);
+
+// offset(v, d) for every d, from one extraction and one distance computation over the band all of
+// them need (an infill's skin and core share it). OpenVDB widens a band by propagating nearest
+// triangles, so the distances can differ from a separate offset's by a fraction of a voxel.
+std::vector<Volume> offsets(const Volume& v, const std::vector<double>& distances_mm);
 
 // The solid minus its inward offset: a hollow part with walls of the given thickness (mm > 0).
 Volume shell(const Volume& v, double thickness_mm);
