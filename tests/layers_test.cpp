@@ -132,6 +132,15 @@ TEST(Layers, ChecksFindEveryKindOfBrokenLayer) {
   EXPECT_FALSE(check_contours({{{0, 0}, {1, 0}, {HUGE_VAL, 1}}}).closed);
   // A spike folding back on its own edge.
   EXPECT_FALSE(check_contours({{{0, 0}, {2, 0}, {1, 0}, {1, 1}}}).simple);
+  // Crossings along a straight stretch of a hollow sphere's SL1 layer (as the slicer placed them):
+  // in doubles, c lies on the line ab (orientation 0) and b on the line cd, so a test that reads
+  // a zero orientation as "between" took the segments ab and cd for meeting. They do not.
+  const Vec2d a{0x1.d39d883ba3444p+2, 0x1.3000431bde82dp-3}, b{0x1.d3a858793dd98p+2, 0x1.a0008637bd05bp-4},
+      cc{0x1.d3b328b6d86ecp+2, 0x1.c0010c6f7a0b6p-5}, d{0x1.d3bdf8f47304p+2, 0x1.000431bde82d8p-7};
+  c = check_contours({{a, b, cc, d, {d.x + 1, d.y}, {a.x + 1, a.y}}});
+  EXPECT_TRUE(c.valid()) << ::testing::PrintToString(c.problems);
+  // The same stretch continued back over itself does meet.
+  EXPECT_FALSE(check_contours({{a, b, cc, d, {d.x + 1, d.y}, {b.x, b.y}, {a.x - 1, a.y}}}).simple);
 }
 
 TEST(Layers, SimplifiedContoursStayWithinTheTolerance) {

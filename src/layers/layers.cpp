@@ -3,12 +3,54 @@
 #include <algorithm>
 #include <cmath>
 #include <utility>
+#include <vector>
 
 namespace lacuna {
 namespace {
 
-double cross2(const Vec2d& a, const Vec2d& b, const Vec2d& c) {
-  return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+// x + y = hi + lo exactly (Knuth's two-sum), and x * y = hi + lo exactly (a fused multiply-add).
+void two_sum(double x, double y, double& hi, double& lo) {
+  hi = x + y;
+  const double yv = hi - x, xv = hi - yv;
+  lo = (x - xv) + (y - yv);
+}
+void two_product(double x, double y, double& hi, double& lo) {
+  hi = x * y;
+  lo = std::fma(x, y, -hi);
+}
+
+// The sign of (b - a) x (c - a), exactly (+1 counter-clockwise, -1 clockwise, 0 collinear): the doubles are trusted beyond Shewchuk's error bound
+// (ccwerrboundA); otherwise every difference and product is split into exact pairs of doubles and
+// their sum kept as an exact expansion. Points on one straight contour stay collinear, so the
+// check below never takes rounding for a crossing.
+int orientation(const Vec2d& a, const Vec2d& b, const Vec2d& c) {
+  const double left = (a.x - c.x) * (b.y - c.y), right = (a.y - c.y) * (b.x - c.x);
+  const double det = left - right;
+  constexpr double kEpsilon = 1.1102230246251565e-16;  // 2^-53
+  const double bound = (3.0 + 16.0 * kEpsilon) * kEpsilon * (std::fabs(left) + std::fabs(right));
+  if (det > bound) return 1;
+  if (-det > bound) return -1;
+  double d[4][2];  // a.x - c.x, b.y - c.y, a.y - c.y, b.x - c.x, each as hi + lo
+  two_sum(a.x, -c.x, d[0][0], d[0][1]);
+  two_sum(b.y, -c.y, d[1][0], d[1][1]);
+  two_sum(a.y, -c.y, d[2][0], d[2][1]);
+  two_sum(b.x, -c.x, d[3][0], d[3][1]);
+  std::vector<double> expansion;  // nonoverlapping, by increasing magnitude; sums to what is added
+  auto add = [&](double x) {
+    for (double& e : expansion) two_sum(x, e, x, e);
+    expansion.push_back(x);
+  };
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j) {
+      double hi, lo;
+      two_product(d[0][i], d[1][j], hi, lo);
+      add(hi), add(lo);
+      two_product(-d[2][i], d[3][j], hi, lo);
+      add(hi), add(lo);
+    }
+  for (auto e = expansion.rbegin(); e != expansion.rend(); ++e)
+    if (*e != 0) return *e > 0 ? 1 : -1;
+  return 0;
 }
 
 double segment_distance(const Vec2d& p, const Vec2d& a, const Vec2d& b) {
@@ -20,16 +62,16 @@ double segment_distance(const Vec2d& p, const Vec2d& a, const Vec2d& b) {
   return std::hypot(p.x - q.x, p.y - q.y);
 }
 
-// Whether closed segments ab and cd share a point.
+// Whether closed segments ab and cd share a point (exact orientations).
 bool segments_meet(const Vec2d& a, const Vec2d& b, const Vec2d& c, const Vec2d& d) {
-  const double o1 = cross2(a, b, c), o2 = cross2(a, b, d), o3 = cross2(c, d, a), o4 = cross2(c, d, b);
-  if (o1 == 0 && o2 == 0) {  // collinear: do their projections overlap?
-    const bool along_x = std::abs(b.x - a.x) >= std::abs(b.y - a.y);
+  const int o1 = orientation(a, b, c), o2 = orientation(a, b, d), o3 = orientation(c, d, a), o4 = orientation(c, d, b);
+  if (o1 == 0 && o2 == 0 && o3 == 0 && o4 == 0) {  // collinear: do their projections overlap?
+    const bool along_x = std::abs(b.x - a.x) + std::abs(d.x - c.x) >= std::abs(b.y - a.y) + std::abs(d.y - c.y);
     auto key = [&](const Vec2d& p) { return along_x ? p.x : p.y; };
     return std::max(std::min(key(a), key(b)), std::min(key(c), key(d))) <=
            std::min(std::max(key(a), key(b)), std::max(key(c), key(d)));
   }
-  return ((o1 <= 0 && o2 >= 0) || (o1 >= 0 && o2 <= 0)) && ((o3 <= 0 && o4 >= 0) || (o3 >= 0 && o4 <= 0));
+  return o1 * o2 <= 0 && o3 * o4 <= 0;
 }
 
 }  // namespace
@@ -271,7 +313,7 @@ ContourCheck check_contours(const Contours& contours) {
               const Vec2d& shared = (s.index + 1) % n == t.index ? b : a;
               const Vec2d& u = (s.index + 1) % n == t.index ? a : b;
               const Vec2d& v = (s.index + 1) % n == t.index ? d : c;
-              if (cross2(u, shared, v) == 0 && (u.x - shared.x) * (v.x - shared.x) + (u.y - shared.y) * (v.y - shared.y) > 0)
+              if (orientation(u, shared, v) == 0 && (u.x - shared.x) * (v.x - shared.x) + (u.y - shared.y) * (v.y - shared.y) > 0)
                 ++self_meetings;
               continue;
             }
