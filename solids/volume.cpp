@@ -4,6 +4,7 @@
 #include <cmath>
 #include <atomic>
 #include <mutex>
+#include <utility>
 #include <openvdb/tools/Composite.h>
 #include <openvdb/tools/Interpolation.h>
 #include <openvdb/tools/MeshToVolume.h>
@@ -122,6 +123,31 @@ void require_same_grid(const Volume& a, const Volume& b, const char* op) {
                        " mm); build both with the same voxel size");
 }
 
+// How far offsets by these distances reach outwards and inwards (mm, >= 0). Throws InvalidInput
+// for a distance that is not finite.
+std::pair<double, double> offset_reach(const std::vector<double>& distances_mm) {
+  double outside = 0, inside = 0;
+  for (double d : distances_mm) {
+    if (!std::isfinite(d)) throw InvalidInput("offset distance must be a finite length in mm");
+    outside = std::max(outside, d);
+    inside = std::max(inside, -d);
+  }
+  return {outside, inside};
+}
+
+// Narrow bands of half width `band` (mm) of the distance shifted by each distance: copies, and the
+// distance itself for the last.
+std::vector<Volume> shifted_bands(const openvdb::FloatGrid::Ptr& distance, const std::vector<double>& distances_mm,
+                                  double band, const VolumeOptions& options) {
+  std::vector<Volume> result(distances_mm.size());
+  for (size_t i = 0; i < distances_mm.size(); ++i) {
+    openvdb::FloatGrid::Ptr grid = i + 1 == distances_mm.size() ? distance : distance->deepCopy();
+    rebuild_band(*grid, static_cast<float>(distances_mm[i]), static_cast<float>(band));
+    result[i] = wrap_grid(grid, options);
+  }
+  return result;
+}
+
 }  // namespace
 
 Volume::Volume() = default;
@@ -236,14 +262,8 @@ Volume intersect(const Volume& a, const Volume& b) {
 Volume offset(const Volume& v, double distance_mm) { return offsets(v, {distance_mm}).front(); }
 
 std::vector<Volume> offsets(const Volume& v, const std::vector<double>& distances_mm) {
-  double outside = 0, inside = 0;
-  for (double d : distances_mm) {
-    if (!std::isfinite(d)) throw InvalidInput("offset distance must be a finite length in mm");
-    outside = std::max(outside, d);
-    inside = std::max(inside, -d);
-  }
-  std::vector<Volume> result(distances_mm.size(), v);
-  if (v.empty() || (outside == 0 && inside == 0)) return result;
+  const auto [outside, inside] = offset_reach(distances_mm);
+  if (v.empty() || (outside == 0 && inside == 0)) return std::vector<Volume>(distances_mm.size(), v);
   // Exact Euclidean offsets: distances to the extracted surface over a band wide enough to hold
   // every moved surface, then shifted. (Re-distancing a narrow band with LevelSetFilter::offset or
   // levelSetRebuild was 30-50x slower on OpenVDB 10; see README.)
@@ -253,16 +273,22 @@ std::vector<Volume> offsets(const Volume& v, const std::vector<double>& distance
     TriMesh surface = extract_surface(v);
     distance = mesh_distance(surface, v.voxel_size_mm(), outside + band, inside + band, "offset");
   }
-  // The last offset that needs the distances shifts them in place; the others shift copies.
-  size_t last = distances_mm.size();
-  while (distances_mm[last - 1] == 0) --last;
-  for (size_t i = 0; i < distances_mm.size(); ++i) {
-    if (distances_mm[i] == 0) continue;
-    openvdb::FloatGrid::Ptr grid = i + 1 == last ? distance : distance->deepCopy();
-    rebuild_band(*grid, static_cast<float>(distances_mm[i]), static_cast<float>(band));
-    result[i] = wrap_grid(grid, v.options());
-  }
+  std::vector<Volume> result = shifted_bands(distance, distances_mm, band, v.options());
+  for (size_t i = 0; i < distances_mm.size(); ++i)
+    if (distances_mm[i] == 0) result[i] = v;
   return result;
+}
+
+std::vector<Volume> mesh_offsets(const TriMesh& mesh, const VolumeOptions& options,
+                                 const std::vector<double>& distances_mm) {
+  if (mesh.triangles.empty()) throw InvalidInput("mesh has no triangles");
+  make_level_set_grid(options);  // validates the options
+  const auto [outside, inside] = offset_reach(distances_mm);
+  for (const MeshComponent& c : mesh_components(mesh))
+    if (c.signed_volume_mm3 < 0) throw InvalidInput("a mesh with a cavity cannot be offset from its triangles alone");
+  const double band = options.voxel_size_mm * options.half_band_voxels;
+  return shifted_bands(mesh_distance(mesh, options.voxel_size_mm, outside + band, inside + band, "offset"),
+                       distances_mm, band, options);
 }
 
 Volume shell(const Volume& v, double thickness_mm) {

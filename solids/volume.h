@@ -62,6 +62,13 @@ Volume offset(const Volume& v, double distance_mm);
 // triangles, so the distances can differ from a separate offset's by a fraction of a voxel.
 std::vector<Volume> offsets(const Volume& v, const std::vector<double>& distances_mm);
 
+// offsets() of mesh_to_volume(closed_mesh), taken from the mesh itself: distances to its own
+// triangles rather than to the level set's surface (which follows them within the interpolation's
+// error), and no surface to extract. The mesh must have no cavity (no inward shell); throws
+// InvalidInput for one that has, or that has no triangles.
+std::vector<Volume> mesh_offsets(const TriMesh& closed_mesh, const VolumeOptions& options,
+                                 const std::vector<double>& distances_mm);
+
 // The solid minus its inward offset: a hollow part with walls of the given thickness (mm > 0).
 Volume shell(const Volume& v, double thickness_mm);
 

@@ -431,6 +431,23 @@ std::string operations_recipe(const TempDir& dir) {
   return path.string();
 }
 
+// Offsets and a shell of an imported closed mesh, distanced from its own triangles: made whole once
+// and clipped to each slab, with no halo of their own (the core 4.5 mm deep: the halo a slab gets
+// anyway, 3.2 mm at 0.2 mm voxels, would not hold offsets of the slab's own surface that deep).
+std::string mesh_offsets_recipe(const TempDir& dir) {
+  const fs::path path = dir / "mesh_ops.json";
+  write_file(path, std::string(R"({"lacuna_recipe": 1, "name": "mesh_ops", "voxel_size_mm": 0.2,
+    "inputs": {"hull": {"type": "mesh", "file": ")") + LACUNA_SOURCE_DIR + R"(/samples/meshes/egg_hull.stl"}},
+    "operations": [
+      {"name": "walls", "op": "shell", "of": "hull", "thickness_mm": 0.8},
+      {"name": "core", "op": "offset", "of": "hull", "distance_mm": -4.5},
+      {"name": "grown", "op": "offset", "of": "hull", "distance_mm": 0.6},
+      {"name": "nested", "op": "union", "of": ["walls", "core"]},
+      {"name": "cut", "op": "difference", "of": ["grown", "nested"]}],
+    "outputs": [{"of": "cut", "file": "cut.stl"}]})");
+  return path.string();
+}
+
 TEST(Slice, SlabBySlabGivesTheWholeRunsBytes) {
   TempDir dir;
   struct Case {
@@ -443,6 +460,7 @@ TEST(Slice, SlabBySlabGivesTheWholeRunsBytes) {
       {operations_recipe(dir), "cut", 0, 0.8},
       // An imported hull filled with a lattice: a mesh converted once and clipped per slab, an infill's skin.
       {source + "/samples/egg_infill.json", "part", 0.3, 2.4},
+      {mesh_offsets_recipe(dir), "cut", 0, 1.6},
       // A streamed CIFS input (cells), no operation: the halo is a band.
       {source + "/samples/menger_sponge.json", "sponge", 0, 2.0},
   };
@@ -486,6 +504,7 @@ TEST(Stream, MeshSlabBySlabIsTheWholeRunsFile) {
       {operations_recipe(dir), "walls", 0, 1.6},
       {operations_recipe(dir), "cut", 0, 3.2},
       {source + "/samples/egg_infill.json", "part", 0.3, 9.6},
+      {mesh_offsets_recipe(dir), "cut", 0, 6.4},
       {source + "/samples/menger_sponge.json", "sponge", 1.0 / 9, 2.0},
   };
   for (size_t i = 0; i < std::size(cases); ++i) {

@@ -278,6 +278,54 @@ TEST(Solids, ClosedMeshToVolume) {
   EXPECT_NEAR(r.volume_mm3, 4.0 / 3.0 * 64, 0.005 * 4.0 / 3.0 * 64);
 }
 
+// Offsets of a closed mesh from its own triangles: the octahedron |x| + |y| + |z| <= 4 shrunk by d is
+// the octahedron of "radius" 4 - d sqrt(3); grown by d it has Steiner's volume V + S d + M d^2 + 4/3 pi d^3
+// (S its area, M the sum over its 12 edges of length times the exterior dihedral angle over 2). The
+// same as the offsets of its level set within the level set's own accuracy.
+TEST(Solids, MeshOffsetsFromTheMeshItself) {
+  TriMesh octa;
+  octa.positions_mm = {{4, 0, 0}, {-4, 0, 0}, {0, 4, 0}, {0, -4, 0}, {0, 0, 4}, {0, 0, -4}};
+  for (uint32_t sx = 0; sx < 2; ++sx)
+    for (uint32_t sy = 0; sy < 2; ++sy)
+      for (uint32_t sz = 0; sz < 2; ++sz) {
+        std::array<uint32_t, 3> t{sx, 2 + sy, 4 + sz};
+        if ((sx + sy + sz) % 2 == 1) std::swap(t[1], t[2]);
+        octa.triangles.push_back(t);
+      }
+  const VolumeOptions options{0.05, 3.0};
+  const std::vector<double> distances{-1.0, 0.5, -0.25};
+  const std::vector<Volume> moved = mesh_offsets(octa, options, distances);
+  ASSERT_EQ(moved.size(), distances.size());
+  const double edge = 4 * std::sqrt(2.0), area = 2 * std::sqrt(3.0) * edge * edge;
+  const double mean_width = 12 * edge * (kPi - std::acos(-1.0 / 3)) / 2;
+  GeometrySet set;
+  set.solids.push_back(octa);
+  const Volume level_set = voxelize(set, options);
+  for (size_t i = 0; i < distances.size(); ++i) {
+    const double d = distances[i];
+    const double r = 4 - std::max(-d, 0.0) * std::sqrt(3.0);
+    const double exact = d < 0 ? 4.0 / 3.0 * r * r * r
+                               : 4.0 / 3.0 * 64 + area * d + mean_width * d * d + 4.0 / 3.0 * kPi * d * d * d;
+    const MeshCheckReport m = mesh_and_check(moved[i]);
+    EXPECT_TRUE(m.valid()) << d << ::testing::PrintToString(m.problems());
+    EXPECT_NEAR(m.volume_mm3, exact, 5e-4 * exact) << d;
+    EXPECT_NEAR(m.volume_mm3, mesh_and_check(offset(level_set, d)).volume_mm3, 0.003 * exact) << d;
+  }
+  // A mesh with a cavity is not offset from its triangles (meshToVolume would fill the cavity).
+  TriMesh hollow;
+  auto cube = [&](double lo, double hi, bool inward) {
+    const uint32_t base = uint32_t(hollow.positions_mm.size());
+    for (int i = 0; i < 8; ++i) hollow.positions_mm.push_back({i & 1 ? hi : lo, i & 2 ? hi : lo, i & 4 ? hi : lo});
+    const uint32_t f[12][3] = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
+                               {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
+    for (const auto& t : f) hollow.triangles.push_back({base + t[0], base + (inward ? t[2] : t[1]), base + (inward ? t[1] : t[2])});
+  };
+  cube(0, 6, false);
+  cube(2, 4, true);
+  EXPECT_THROW(mesh_offsets(hollow, options, {-0.5}), InvalidInput);
+  EXPECT_THROW(mesh_offsets(octa, options, {HUGE_VAL}), InvalidInput);
+}
+
 TEST(Solids, ClosedMeshWithCavityAndIsland) {
   // A cube of 12 around a cavity of 8 (facing inward) holding an island of 4: 1728 - 512 + 64.
   TriMesh m;

@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <set>
 #include <variant>
 
 #include "errors.h"
 #include "pipeline/detail/memory.h"
 #include "solids/budget.h"
+#include "solids/components.h"
 #include "solids/infill.h"
 #include "solids/voxelize.h"
 #include "util/system.h"
@@ -43,6 +45,39 @@ const RecipeOperation& operation_named(const Recipe& recipe, const std::string& 
   throw InternalError("no operation is named \"" + name + "\"");
 }
 
+// The closed mesh an input's level set is converted from, when that is all the input is (one
+// closed mesh without a cavity, nothing else): offsets of it are then distances to its own
+// triangles (mesh_offsets), made whole, so a slab needs no halo for them.
+const TriMesh* lone_closed_mesh(const Plan& plan, const BuiltInputs& inputs, const std::string& name) {
+  if (std::find(plan.inputs.begin(), plan.inputs.end(), name) == plan.inputs.end()) return nullptr;
+  const GeometrySet& g = inputs.at(name).geometry;
+  if (g.solids.size() != 1 || !g.tubes.tubes.empty() || !g.spheres.centers_mm.empty() || !g.shapes.empty() ||
+      !g.surfaces.empty() || !g.regions.empty() || !g.cells.empty() || !g.streams.empty())
+    return nullptr;
+  for (const MeshComponent& c : mesh_components(g.solids[0]))
+    if (c.signed_volume_mm3 < 0) return nullptr;
+  return &g.solids[0];
+}
+
+// The operand an offset, shell or infill distances (an infill's hull); empty for a CSG operation.
+std::string distanced_operand(const OperationSpec& op) {
+  if (const auto* offset = std::get_if<OffsetOperation>(&op)) return offset->of;
+  if (const auto* shell = std::get_if<ShellOperation>(&op)) return shell->of;
+  if (const auto* fill = std::get_if<InfillOperation>(&op)) return fill->hull;
+  return {};
+}
+
+// The operations whose offsets come from an input's own mesh, each with that mesh.
+std::map<std::string, const TriMesh*> mesh_offset_operations(const Recipe& recipe, const Plan& plan,
+                                                             const BuiltInputs& inputs) {
+  std::map<std::string, const TriMesh*> out;
+  for (const std::string& name : plan.operations) {
+    const std::string operand = distanced_operand(operation_named(recipe, name).spec);
+    if (operand.empty()) continue;
+    if (const TriMesh* mesh = lone_closed_mesh(plan, inputs, operand)) out[name] = mesh;
+  }
+  return out;
+}
 
 // The share of a box's height inside the slab's reach (1 without a slab).
 double slab_share(const Box3& box, const ZSlab* slab, double band) {
@@ -76,7 +111,8 @@ std::map<std::string, MemoryEstimate> input_estimates(const Recipe& recipe, cons
 
 // Memory for everything the plan builds, refused before any large allocation.
 MemoryNeed estimate(const Recipe& recipe, const Plan& plan, const std::map<std::string, MemoryEstimate>& input_estimate,
-                  const VolumeOptions& vopt, const std::map<std::string, ObjectExtent>& extents, const ZSlab* slab) {
+                  const VolumeOptions& vopt, const std::map<std::string, ObjectExtent>& extents,
+                  const std::set<std::string>& from_mesh, const ZSlab* slab) {
   struct Object {
     double area = 0;
     Box3 box;
@@ -128,13 +164,23 @@ MemoryNeed estimate(const Recipe& recipe, const Plan& plan, const std::map<std::
                            fixed(offset->distance_mm, 6) + " mm leaves nothing of \"" + of[0] + "\" (it is at most " +
                            fixed(2 * half_thickness, 6) + " mm thick)");
       if (!offset || offset->distance_mm < 0) d = std::min(d, half_thickness);
-      total.mesh_bytes = std::max(total.mesh_bytes, estimate_from_voxels(first.voxels, vopt).surface_bytes);
       // The band grows by the distance on one side only (outwards for a growing offset, inwards
       // otherwise): as much as half of it on each.
       work.half_band_voxels += 0.5 * d / vopt.voxel_size_mm;
-      // The band as wide as the distance is around the first operand only (an infill's hull).
-      MemoryEstimate wide = estimate_from_voxels(band_voxels(first.area, o.box, work), work);
-      total.grid_bytes += wide.grid_bytes;
+      if (from_mesh.count(name)) {
+        // Distances to the input's own mesh, over the whole part (in a streamed run, made in the first
+        // slab and kept, with its offsets' bands, for the others); no surface is extracted.
+        const double area = input_estimate.at(of[0]).surface_area_mm2;
+        const Box3& box = extents.at(of[0]).box;
+        total.grid_bytes += estimate_from_voxels(band_voxels(area, box, work), work).grid_bytes;
+        const uint64_t kept = std::holds_alternative<InfillOperation>(op) ? 2 : 1;
+        if (slab) total.grid_bytes += kept * estimate_from_voxels(band_voxels(area, box, vopt), vopt).grid_bytes;
+      } else {
+        total.mesh_bytes = std::max(total.mesh_bytes, estimate_from_voxels(first.voxels, vopt).surface_bytes);
+        // The band as wide as the distance is around the first operand only (an infill's hull).
+        MemoryEstimate wide = estimate_from_voxels(band_voxels(first.area, o.box, work), work);
+        total.grid_bytes += wide.grid_bytes;
+      }
     }
     o.voxels = band_voxels(o.area, o.box, vopt);
     MemoryEstimate e = estimate_from_voxels(o.voxels, vopt);
@@ -152,10 +198,12 @@ MemoryNeed estimate(const Recipe& recipe, const Plan& plan, const std::map<std::
 
 std::map<std::string, ObjectExtent> object_extents(const Recipe& recipe, const Plan& plan, const BuiltInputs& inputs) {
   const double h = recipe.voxel_size_mm, band = h * recipe.band_voxels;
+  const std::map<std::string, const TriMesh*> from_mesh = mesh_offset_operations(recipe, plan, inputs);
   std::map<std::string, ObjectExtent> extents;
   // A rasterized input equals the whole run's a band inside the slab (its faces' band); a level set
   // remade from a surface (offsets, shells, infills) needs its operand right out to the distance it
-  // reaches, a band, and the voxel cubes its triangles come from.
+  // reaches, a band, and the voxel cubes its triangles come from. Offsets of an input's own mesh are
+  // made whole and clipped: exact a band inside the slab, which the input's halo already holds.
   for (const std::string& name : plan.inputs) extents[name] = {bounding_box(inputs.at(name).geometry), band + h};
   for (const std::string& name : plan.operations) {
     const OperationSpec& op = operation_named(recipe, name).spec;
@@ -175,17 +223,18 @@ std::map<std::string, ObjectExtent> object_extents(const Recipe& recipe, const P
           }
     } else if (const auto* offset = std::get_if<OffsetOperation>(&op)) {
       const double d = offset->distance_mm;
-      e.halo_mm += std::fabs(d) + band + 3 * h;
+      if (!from_mesh.count(name)) e.halo_mm += std::fabs(d) + band + 3 * h;
       if (d > 0) {
         e.box.min -= Vec3d{d, d, d};
         e.box.max += Vec3d{d, d, d};
       }
     } else if (const auto* shell = std::get_if<ShellOperation>(&op)) {
-      e.halo_mm += shell->thickness_mm + band + 3 * h;
+      if (!from_mesh.count(name)) e.halo_mm += shell->thickness_mm + band + 3 * h;
     } else {
       const auto& fill = std::get<InfillOperation>(op);
       const ObjectExtent& hull = extents.at(fill.hull);
-      e = {hull.box, std::max(extents.at(fill.structure).halo_mm, hull.halo_mm + fill.skin_mm + band + 3 * h)};
+      const double skin_halo = from_mesh.count(name) ? 0 : fill.skin_mm + band + 3 * h;
+      e = {hull.box, std::max(extents.at(fill.structure).halo_mm, hull.halo_mm + skin_halo)};
     }
     extents[name] = e;
   }
@@ -202,10 +251,13 @@ MemoryEstimator::MemoryEstimator(const Recipe& recipe, const Plan& plan, const B
     : recipe_(recipe),
       plan_(plan),
       extents_(object_extents(recipe, plan, inputs)),
-      inputs_(input_estimates(recipe, plan, inputs, VolumeOptions{recipe.voxel_size_mm, recipe.band_voxels})) {}
+      inputs_(input_estimates(recipe, plan, inputs, VolumeOptions{recipe.voxel_size_mm, recipe.band_voxels})) {
+  for (const auto& entry : mesh_offset_operations(recipe, plan, inputs)) from_mesh_.insert(entry.first);
+}
 
 MemoryNeed MemoryEstimator::need(const ZSlab* slab) const {
-  return estimate(recipe_, plan_, inputs_, VolumeOptions{recipe_.voxel_size_mm, recipe_.band_voxels}, extents_, slab);
+  return estimate(recipe_, plan_, inputs_, VolumeOptions{recipe_.voxel_size_mm, recipe_.band_voxels}, extents_,
+                  from_mesh_, slab);
 }
 
 uint64_t MemoryEstimator::bytes(const std::vector<ZSlab>& slabs) const {
@@ -267,10 +319,27 @@ Evaluation evaluate(const Recipe& recipe, const Plan& plan, const BuiltInputs& i
                                       });
   }
   timer.start("combine");
+  const std::map<std::string, const TriMesh*> from_mesh = mesh_offset_operations(recipe, plan, inputs);
   for (const std::string& name : plan.operations) {
     throw_if_cancelled(sink);
     const RecipeOperation& op = operation_named(recipe, name);
     const std::string where = recipe.file + ": " + op.json_path;
+    // Offsets of an input's own mesh (whole, made once for every slab of a streamed run), or null.
+    const auto mesh_it = from_mesh.find(name);
+    const TriMesh* mesh = mesh_it == from_mesh.end() ? nullptr : mesh_it->second;
+    auto offsets_of_mesh = [&](const std::vector<double>& distances_mm) {
+      std::vector<Volume> whole;
+      if (options.slab && options.mesh_offsets) {
+        auto [kept, made] = options.mesh_offsets->try_emplace(name);
+        if (made) kept->second = mesh_offsets(*mesh, vopt, distances_mm);
+        whole = kept->second;
+      } else {
+        whole = mesh_offsets(*mesh, vopt, distances_mm);
+      }
+      if (options.slab)
+        for (Volume& w : whole) w = clip_to_slab(w, *options.slab);
+      return whole;
+    };
     Volume v;
     if (const auto* csg = std::get_if<CsgOperation>(&op.spec)) {
       v = result.take(csg->of[0]);
@@ -284,19 +353,31 @@ Evaluation evaluate(const Recipe& recipe, const Plan& plan, const BuiltInputs& i
       }
     } else if (const auto* offset = std::get_if<OffsetOperation>(&op.spec)) {
       v = result.take(offset->of);
-      detail::require_surface_memory(v, budget, where, vopt);
-      v = lacuna::offset(v, offset->distance_mm);
+      if (mesh && offset->distance_mm != 0) {
+        v = offsets_of_mesh({offset->distance_mm}).front();
+      } else {
+        detail::require_surface_memory(v, budget, where, vopt);
+        v = lacuna::offset(v, offset->distance_mm);
+      }
     } else if (const auto* shell = std::get_if<ShellOperation>(&op.spec)) {
       v = result.take(shell->of);
-      detail::require_surface_memory(v, budget, where, vopt);
-      v = lacuna::shell(v, shell->thickness_mm);
+      if (mesh) {
+        if (!(shell->thickness_mm > 0)) throw InvalidInput(where + ": shell thickness must be a positive length in mm");
+        v = subtract(v, offsets_of_mesh({-shell->thickness_mm}).front());
+      } else {
+        detail::require_surface_memory(v, budget, where, vopt);
+        v = lacuna::shell(v, shell->thickness_mm);
+      }
     } else {
       const auto& fill = std::get<InfillOperation>(op.spec);
       Volume hull = result.take(fill.hull), structure = result.take(fill.structure);
-      detail::require_surface_memory(hull, budget, where, vopt);
+      if (!mesh) detail::require_surface_memory(hull, budget, where, vopt);
       // Fused by a voxel unless told otherwise (and never through the whole skin).
       double fuse = fill.fuse_mm >= 0 ? fill.fuse_mm : std::min(vopt.voxel_size_mm, 0.5 * fill.skin_mm);
-      v = in_context(where, [&] { return infill(hull, structure, fill.skin_mm, fuse); });
+      v = in_context(where, [&] {
+        return mesh ? infill(hull, structure, offsets_of_mesh(infill_offsets(fill.skin_mm, fuse)))
+                    : infill(hull, structure, fill.skin_mm, fuse);
+      });
       result.hull_volume_mm3[op.name] = hull.voxel_volume_mm3();
     }
     result.volumes[op.name] = v;

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <map>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -28,6 +29,9 @@ struct EvaluateOptions {
   const ZSlab* slab = nullptr;
   // A streamed run's inputs' closed meshes, converted in the first slab and kept for the others.
   std::map<std::string, Volume>* converted_meshes = nullptr;
+  // A streamed run's offsets of inputs' own meshes (offset, shell and infill operations on an input
+  // that is one closed mesh), by operation: made whole in the first slab, clipped in each.
+  std::map<std::string, std::vector<Volume>>* mesh_offsets = nullptr;
   // The plan's estimator, made once for every slab (null: made here).
   const class MemoryEstimator* estimator = nullptr;
 };
@@ -79,6 +83,7 @@ class MemoryEstimator {
   const Plan& plan_;
   std::map<std::string, ObjectExtent> extents_;
   std::map<std::string, MemoryEstimate> inputs_;
+  std::set<std::string> from_mesh_;  // operations whose offsets come from an input's own mesh
 };
 
 // Voxelizes the planned inputs and evaluates the planned operations. Throws ResourceLimit, before

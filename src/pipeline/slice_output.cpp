@@ -510,12 +510,14 @@ SliceReport slice_recipe(Recipe recipe, const std::string& output, const SliceOp
     });
   uint64_t estimate = 0;
   std::map<std::string, Volume> converted_meshes;  // a streamed run's imported meshes, converted once
+  std::map<std::string, std::vector<Volume>> mesh_offsets;  // and their offsets, made once
   auto evaluate_slab = [&](size_t i) {
     throw_if_cancelled(sink);
     EvaluateOptions evaluate_options;
     evaluate_options.max_memory_bytes = budget;
     evaluate_options.slab = slab_height > 0 ? &slabs[i] : nullptr;
     evaluate_options.converted_meshes = slab_height > 0 ? &converted_meshes : nullptr;
+    evaluate_options.mesh_offsets = slab_height > 0 ? &mesh_offsets : nullptr;
     evaluate_options.estimator = &*estimator;
     timer.start("evaluate");
     Evaluation evaluation = evaluate(only, *p, *inputs, evaluate_options);
@@ -569,6 +571,7 @@ SliceReport slice_recipe(Recipe recipe, const std::string& output, const SliceOp
     for (size_t i = kept_slab + 1; i < end_slab; ++i) slicer.sample(evaluate_slab(i), slab_hi(i));
   });
   converted_meshes.clear();
+  mesh_offsets.clear();
 
   // 3. The first process gathers every layer (figures, problems, contours, where the images are).
   if (ranks) {

@@ -315,12 +315,14 @@ StreamedOutput stream_output(const Recipe& recipe, const RecipeOutput& out, cons
       part.batches.push_back(batch);
     });
     std::map<std::string, Volume> converted_meshes;  // a streamed run's imported meshes, converted once
+    std::map<std::string, std::vector<Volume>> mesh_offsets;  // and their offsets, made once
     auto evaluate_slab = [&](const ZSlab* slab) {
       throw_if_cancelled(sink);
       EvaluateOptions evaluate_options;
       evaluate_options.max_memory_bytes = budget;
       evaluate_options.slab = slab;
       evaluate_options.converted_meshes = slab ? &converted_meshes : nullptr;
+      evaluate_options.mesh_offsets = slab ? &mesh_offsets : nullptr;
       evaluate_options.estimator = &*estimator;
       timer.start("evaluate");
       Evaluation evaluation = evaluate(only, *p, *inputs, evaluate_options);
