@@ -1,6 +1,9 @@
 #include "util/system.h"
 
 #include <fcntl.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -51,6 +54,12 @@ uint64_t status_field_bytes(const char* field) {
 uint64_t peak_memory_bytes() { return status_field_bytes("VmHWM"); }
 
 uint64_t current_memory_bytes() { return status_field_bytes("VmRSS"); }
+
+void release_free_memory() {
+#ifdef __GLIBC__
+  malloc_trim(0);
+#endif
+}
 
 uint64_t peak_child_memory_bytes() {
   rusage usage{};

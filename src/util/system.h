@@ -23,6 +23,11 @@ uint64_t peak_child_memory_bytes();
 // Resident set size of this process now, in bytes (VmRSS); 0 where unknown.
 uint64_t current_memory_bytes();
 
+// Hands the heap memory freed so far back to the system: glibc keeps freed pages of its heaps
+// mapped, and the resident memory (and so the peak a run reports and is held to) counts them. A
+// no-op where the C library has no malloc_trim.
+void release_free_memory();
+
 // Wall-clock seconds per named stage, in the order the stages ran.
 class StageTimer {
  public:
