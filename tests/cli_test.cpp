@@ -1311,6 +1311,52 @@ TEST(Cli, BcifsInfillConformsToTheHull) {
   EXPECT_LT(farthest, 6.5 + 0.2);  // the inset, give or take the voxels
 }
 
+// Cells graded in size: a 15 mm box's inset filled from 6 mm Kuhn tetrahedra bisected (conformingly) down to
+// 1.4 mm along a ramp in x, so the tetrahedra vary more than 4x in size (the cut ones at the skin more); delays
+// and last-level scales bring every lacuna within 1.5x of the others, where without them the lacunas vary as
+// the cells do. With sealed level-1 cells the mesh's volume is the cells' exact volume: the bisected
+// tetrahedra tile the inset without overlaps or gaps, and every lacuna is a cavity of its own.
+TEST(Cli, BcifsInfillCellsGradedInSize) {
+  TempDir dir;
+  const std::string grade = R"("cell_grade": {"min_cell_mm": 1.4, "field": "ramp", "axis": [1, 0, 0], "from_mm": -6.5, "to_mm": 6.5})";
+  write_file(dir / "fill.json", R"({"voxel_size_mm": 0.15, "inputs": {
+      "box": {"type": "box", "min_mm": [-7.5, -7.5, -7.5], "max_mm": [7.5, 7.5, 7.5]},
+      "sized": {"type": "bcifs_infill", "hull": "box", "skin_mm": 1, "cell_mm": 6, "level": 2, "edge": "B2",
+                "params": "B2 B2 B2", "lacuna_scale": 0.5, "face_lacuna_scale": 0.7, )" + grade + R"(},
+      "unequal": {"type": "bcifs_infill", "hull": "box", "skin_mm": 1, "cell_mm": 6, "level": 2, "edge": "B2",
+                  "params": "B2 B2 B2", "lacuna_scale": 0.5, "face_lacuna_scale": 0.7, "equal_lacunas": false, )" +
+                                        grade + R"(},
+      "uniform": {"type": "bcifs_infill", "hull": "box", "skin_mm": 1, "cell_mm": 6, "level": 1, "walls": "plain",
+                  "interior": "plain", "lacuna_scale": 0.5, "equal_lacunas": false},
+      "sealed": {"type": "bcifs_infill", "hull": "box", "skin_mm": 1, "cell_mm": 6, "level": 1, "walls": "plain",
+                 "interior": "plain", "lacuna_scale": 0.5, "equal_lacunas": false, )" + grade + R"(}},
+      "outputs": [{"of": "sealed", "file": "sealed.stl"}]})");
+  Result r = lacuna("run " + quote((dir / "fill.json").string()) + " -o " + quote((dir / "out").string()) + " --json",
+                    dir.path());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json output = nlohmann::json::parse(r.out)["outputs"][0];
+  const nlohmann::json inputs = nlohmann::json::parse(read_file(dir / "out" / "report.json"))["inputs"];
+  const nlohmann::json sized = inputs["sized"], unequal = inputs["unequal"], sealed = inputs["sealed"];
+  auto spread = [](const nlohmann::json& range) { return range[1].get<double>() / range[0].get<double>(); };
+  EXPECT_EQ(sized["tetrahedra"], unequal["tetrahedra"]);
+  EXPECT_GT(sized["tetrahedra"].get<double>(), 4 * inputs["uniform"]["tetrahedra"].get<double>());
+  EXPECT_GT(spread(sized["cell_mm"]), 4.0);
+  EXPECT_LT(spread(sized["lacuna_mm"]), 1.5);
+  EXPECT_GT(spread(unequal["lacuna_mm"]), 4.0);
+  EXPECT_TRUE(output["checks"]["valid"].get<bool>());
+  EXPECT_NEAR(output["volume_mm3"].get<double>(), sealed["volume_mm3"].get<double>(), 0.03 * sealed["volume_mm3"].get<double>());
+  EXPECT_GT(output["components"].get<double>(), 0.5 * sealed["lacunas"].get<double>());
+  // A grade the cells cannot follow is refused by name.
+  write_file(dir / "fine.json", R"({"voxel_size_mm": 0.15, "inputs": {
+      "box": {"type": "box", "min_mm": [-7.5, -7.5, -7.5], "max_mm": [7.5, 7.5, 7.5]},
+      "x": {"type": "bcifs_infill", "hull": "box", "cell_mm": 6, "cell_grade": {"min_cell_mm": 0.5, "field": "depth", "depth_mm": 3}}},
+      "outputs": [{"of": "x", "file": "x.stl"}]})");
+  Result fine = lacuna("run " + quote((dir / "fine.json").string()) + " -o " + quote((dir / "out2").string()), dir.path());
+  EXPECT_EQ(fine.code, 2);
+  EXPECT_NE(fine.err.find("inputs.x.cell_grade.min_cell_mm"), std::string::npos) << fine.err;
+  EXPECT_FALSE(fs::exists(dir / "out2"));
+}
+
 // A lacunar cube: at level 0 its faces are whole, and the cell is the cube shell s^3 - (s - 2t)^3 (two
 // components: the cavity is sealed); at level 1 every face has its lacuna and every C2 edge one gap, where the
 // notches of both faces open the edge: a sphere with 6 + 12 openings, thickened, has genus 17.

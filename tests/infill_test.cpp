@@ -5,8 +5,10 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <set>
 
 #include "errors.h"
+#include "infill/bisection.h"
 #include "infill/lattice.h"
 #include "solids/check.h"
 #include "solids/extract.h"
@@ -111,6 +113,75 @@ TEST(Printability, OverhangOfABoxOnThePlate) {
   EXPECT_NEAR(analyze_printability(box({o, o, o}, {10 + o, 10 + o, 10 + o}, h), options).overhang_area_mm2, 0, 1e-9);
   Volume table = unite(box({o, o, 5 + o}, {10 + o, 10 + o, 10 + o}, h), box({4 + o, 4 + o, o}, {6 + o, 6 + o, 5.2 + o}, h));
   EXPECT_NEAR(analyze_printability(table, options).overhang_area_mm2, 96, 0.02 * 96);
+}
+
+// Kuhn's grid of 4 x 3 x 2 cubes of side 2, bisected where a ramp along x wants cells down to a quarter of the
+// side (six bisections) on the right: the tetrahedra still tile the grid (volumes add up to 48 mm^3), every
+// bisection halves a volume (each tetrahedron is (8/6) / 2^depth), no two share a corner position twice, and
+// the grid conforms: each triangle of a tetrahedron is a triangle of exactly one other, or lies on the grid's
+// boundary. Every tetrahedron has at least the bisections the ramp wants at its centre, and the closure adds
+// at most a few.
+TEST(Infill, BisectedKuhnGridConformsAndFollowsTheField) {
+  const int nx = 4, ny = 3, nz = 2;
+  const double side = 2;
+  auto index = [&](int i, int j, int k) { return uint32_t((k * (ny + 1) + j) * (nx + 1) + i); };
+  std::vector<Vec3d> points;
+  for (int k = 0; k <= nz; ++k)
+    for (int j = 0; j <= ny; ++j)
+      for (int i = 0; i <= nx; ++i) points.push_back(Vec3d{double(i), double(j), double(k)} * side);
+  std::vector<GridTet> tets;
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i)
+        for (const GridTet& t : kuhn_tetrahedra([&](int c) { return index(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1)); }))
+          tets.push_back(t);
+  ASSERT_EQ(tets.size(), size_t(6 * nx * ny * nz));
+  auto wanted = [&](const Vec3d& p) { return int(std::lround(6 * std::clamp(p.x / (nx * side), 0.0, 1.0))); };
+  std::vector<double> distances(points.size(), -1.0);  // everything is of interest
+  size_t largest = 0;
+  refine_grid_tets(points, distances, tets, wanted, [](const Vec3d&) { return -1.0; },
+                   [&](size_t n) { largest = std::max(largest, n); });
+  EXPECT_EQ(largest, tets.size());
+  EXPECT_EQ(distances.size(), points.size());
+  auto volume = [&](const GridTet& t) {
+    const Vec3d &a = points[t.v[0]], &b = points[t.v[1]], &c = points[t.v[2]], &d = points[t.v[3]];
+    return std::fabs(dot(b - a, cross(c - a, d - a))) / 6;
+  };
+  double total = 0;
+  int deepest = 0;
+  std::map<std::array<uint32_t, 3>, int> faces;
+  for (const GridTet& t : tets) {
+    const double v = volume(t);
+    total += v;
+    EXPECT_NEAR(v * std::ldexp(1.0, t.depth), side * side * side / 6, 1e-12);
+    const Vec3d centre = (points[t.v[0]] + points[t.v[1]] + points[t.v[2]] + points[t.v[3]]) * 0.25;
+    EXPECT_GE(t.depth, wanted(centre));
+    EXPECT_LE(t.depth, wanted(centre) + 3);
+    deepest = std::max(deepest, t.depth);
+    for (int skip = 0; skip < 4; ++skip) {
+      std::array<uint32_t, 3> f{};
+      size_t n = 0;
+      for (int q = 0; q < 4; ++q)
+        if (q != skip) f[n++] = t.v[size_t(q)];
+      std::sort(f.begin(), f.end());
+      ++faces[f];
+    }
+  }
+  EXPECT_NEAR(total, nx * ny * nz * side * side * side, 1e-9);
+  EXPECT_EQ(deepest, 6);
+  for (const auto& [f, n] : faces) {
+    const Vec3d &a = points[f[0]], &b = points[f[1]], &c = points[f[2]];
+    bool on_boundary = false;
+    for (int axis = 0; axis < 3; ++axis) {
+      const double top = axis == 0 ? nx * side : axis == 1 ? ny * side : nz * side;
+      for (double plane : {0.0, top})
+        on_boundary = on_boundary || (a[axis] == plane && b[axis] == plane && c[axis] == plane);
+    }
+    EXPECT_EQ(n, on_boundary ? 1 : 2) << a.x << " " << a.y << " " << a.z;
+  }
+  std::set<std::array<double, 3>> distinct;
+  for (const Vec3d& p : points) distinct.insert({p.x, p.y, p.z});
+  EXPECT_EQ(distinct.size(), points.size());
 }
 
 TEST(Infill, CubeHullWithLatticeSkinAndOnePart) {

@@ -19,6 +19,7 @@
 #include "fill/motif_solids.h"
 #include "fill/polyhedra.h"
 #include "fill/wallpaper.h"
+#include "infill/bisection.h"
 #include "infill/lattice.h"
 #include "solids/check.h"
 #include "solids/parameterize.h"
@@ -719,7 +720,8 @@ class Builder {
   // inset (skin_mm in) kept and their outside corners moved onto the inset surface, so the cells conform to it.
   // Tetrahedra keep every face planar however their corners move (a moved hexahedron would not). Faces two
   // tetrahedra share are shared cells' faces, so the structure is consistent across them; delays by size give
-  // every cell lacunas of about one size.
+  // every cell lacunas of about one size. A cell grade halves the tetrahedra (Maubach's bisection, which keeps
+  // them conforming) down to min_cell_mm where its field is 1.
   void add(const BcifsInfillInput& b) {
     const double h = b.cell_mm;
     VolumeOptions coarse;
@@ -739,7 +741,7 @@ class Builder {
     if (double(count[0]) * double(count[1]) * double(count[2]) > 4e6)
       fail("cell_mm", "cells of " + message_number(h) + " mm make more than 4 000 000 grid corners in the hull; "
                       "use larger cells");
-    auto index = [&](int64_t i, int64_t j, int64_t k) { return size_t((k * count[1] + j) * count[0] + i); };
+    auto index = [&](int64_t i, int64_t j, int64_t k) { return uint32_t((k * count[1] + j) * count[0] + i); };
     const size_t corners = size_t(count[0] * count[1] * count[2]);
     std::vector<Vec3d> point(corners);
     std::vector<double> distance(corners);
@@ -750,25 +752,37 @@ class Builder {
           point[v] = Vec3d{double(lo[0] + i), double(lo[1] + j), double(lo[2] + k)} * h;
           distance[v] = inset.distance_at(point[v]);
         }
-    // Kuhn's six tetrahedra of a cube (corner bits x = 1, y = 2, z = 4), all around the diagonal 0-7.
-    static const int kKuhn[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7}, {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
-    std::vector<std::array<size_t, 4>> kept;
-    std::vector<char> moves(corners, 0);
+    // Kuhn's six tetrahedra of every cube, bisected conformingly (infill/bisection.h) where the cell grade asks
+    // for smaller cells.
+    std::vector<GridTet> tets;
     for (int64_t k = 0; k + 1 < count[2]; ++k)
       for (int64_t j = 0; j + 1 < count[1]; ++j)
         for (int64_t i = 0; i + 1 < count[0]; ++i)
-          for (const auto& t : kKuhn) {
-            std::array<size_t, 4> c{};
-            bool inside = false;
-            for (int q = 0; q < 4; ++q) {
-              c[size_t(q)] = index(i + (t[q] & 1), j + ((t[q] >> 1) & 1), k + ((t[q] >> 2) & 1));
-              inside = inside || distance[c[size_t(q)]] < 0;
-            }
-            if (!inside) continue;
-            kept.push_back(c);
-            for (size_t q : c)
-              if (distance[q] >= 0) moves[q] = 1;
-          }
+          for (const GridTet& t : kuhn_tetrahedra([&](int c) { return index(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1)); }))
+            tets.push_back(t);
+    if (b.cell_grade.kind != GradeField::Kind::kNone) {
+      const Field depth = b.cell_grade.kind == GradeField::Kind::kDepth ? depth_in(b.hull, b.cell_grade.depth_mm) : Field{};
+      const double octaves = std::log2(h / b.min_cell_mm);
+      // Three bisections for every octave the cell size falls at a point.
+      refine_grid_tets(
+          point, distance, tets, [&](const Vec3d& p) { return int(std::lround(3 * octaves * b.cell_grade.at(p, depth))); },
+          [&](const Vec3d& p) { return inset.distance_at(p); },
+          [&](size_t count_now) {
+            if (double(count_now) > bcifs::kMaxVolumeCells)
+              fail("cell_grade", "cells down to " + message_number(b.min_cell_mm) + " mm make more than " +
+                                     message_number(bcifs::kMaxVolumeCells) + " tetrahedra; use a larger min_cell_mm");
+          });
+    }
+    std::vector<std::array<uint32_t, 4>> kept;
+    std::vector<char> moves(point.size(), 0);
+    for (const GridTet& t : tets) {
+      bool inside = false;
+      for (uint32_t q : t.v) inside = inside || distance[q] < 0;
+      if (!inside) continue;
+      kept.push_back(t.v);
+      for (uint32_t q : t.v)
+        if (distance[q] >= 0) moves[q] = 1;
+    }
     // Every tetrahedron makes at least one cell at every level: refuse before building millions of them.
     if (double(kept.size()) > bcifs::kMaxVolumeCells)
       throw ResourceLimit(where() + ".cell_mm: cells of " + message_number(h) + " mm make " +
@@ -777,7 +791,7 @@ class Builder {
     // Outside corners onto the inset surface: Newton steps along the distance's gradient.
     const double step = coarse.voxel_size_mm;
     std::vector<Vec3d> moved = point;
-    for (size_t v = 0; v < corners; ++v) {
+    for (size_t v = 0; v < point.size(); ++v) {
       if (!moves[v]) continue;
       Vec3d p = point[v];
       for (int it = 0; it < 4; ++it) {
@@ -796,7 +810,6 @@ class Builder {
     bcifs::VolumeSpec spec;
     spec.interior = b.interior;
     std::vector<double> sizes;
-    const double regular = h * h * h / 6;  // a Kuhn tetrahedron's volume
     for (const auto& t : kept) {
       if (moves[t[0]] == 2 || moves[t[1]] == 2 || moves[t[2]] == 2 || moves[t[3]] == 2) continue;
       bcifs::CellSpec c;
@@ -808,7 +821,7 @@ class Builder {
       for (size_t q : t) before.push_back(point[q]);
       const double was = signed_volume(before), now = signed_volume(c.shape.corners_mm);
       // Flattened or turned over by the move: dropped (the skin closes what is left there).
-      if (!(now * was > 0) || std::fabs(now) < 0.05 * regular) continue;
+      if (!(now * was > 0) || std::fabs(now) < 0.05 * std::fabs(was)) continue;
       if (now < 0) std::swap(c.shape.corners_mm[1], c.shape.corners_mm[2]);
       // Positively oriented (corner 3 on the side the normal of 0, 1, 2 points to): these run outward.
       c.shape.faces = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}};

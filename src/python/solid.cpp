@@ -432,7 +432,7 @@ const char* kInputDocs[][2] = {
      "face_lacuna_scale, gap_fraction, notch_depth, realization."},
     {"bcifs_infill",
      "A hull filled with lacunar cells: hull (another input), skin_mm (1), cell_mm (10), level (2), equal_lacunas "
-     "(true), grade (field, levels), walls, edge, params, algorithm, interior, radial, interior_params, interior_algorithm, lacuna_scale, "
+     "(true), grade (field, levels), cell_grade (min_cell_mm, field), walls, edge, params, algorithm, interior, radial, interior_params, interior_algorithm, lacuna_scale, "
      "face_lacuna_scale, gap_fraction, notch_depth, realization."},
 };
 

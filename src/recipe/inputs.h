@@ -260,6 +260,11 @@ struct BcifsInfillInput {
   // `level` (every cell subdivides at least once), so faces between levels stay consistent.
   GradeField grade;     // kind kNone: no grading
   int grade_levels = 0;
+  // Graded cell size: where cell_grade is 1 the cells are min_cell_mm, where it is 0 cell_mm, geometrically
+  // between (in steps of a third of an octave: Kuhn tetrahedra bisected, Maubach's way, which keeps them
+  // conforming). kind kNone: every cell from the grid of cell_mm.
+  GradeField cell_grade;
+  double min_cell_mm = 0;
   bcifs::FaceType face;  // one edge in its boundary: the type of every edge
   bool plain = false;
   bcifs::InteriorFaces interior;

@@ -335,6 +335,16 @@ BcifsInfillInput parse_bcifs_infill_input(const JsonObject& o) {
                            " levels the field may take away (every cell subdivides at least once)");
     in.grade_levels = int(levels);
   }
+  if (o.has("cell_grade")) {
+    const JsonObject g = o.object("cell_grade");
+    g.allow_only({"min_cell_mm", "field", "axis", "from_mm", "to_mm", "points_mm", "falloff_mm", "depth_mm"});
+    in.cell_grade = parse_grade_field(g, "");
+    in.min_cell_mm = g.positive_length("min_cell_mm");
+    // Each third of an octave is one more bisection of every cell there (and of neighbours, to conform).
+    if (!(in.min_cell_mm < in.cell_mm) || in.cell_mm / in.min_cell_mm > 8)
+      g.fail("min_cell_mm", "expected a cell size below cell_mm (" + message_number(in.cell_mm) +
+                                " mm) and at least an eighth of it");
+  }
   return in;
 }
 

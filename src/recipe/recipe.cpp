@@ -94,7 +94,7 @@ const std::map<std::string, InputType>& types() {
              {"bcifs_infill",
               {"hull", "skin_mm", "cell_mm", "equal_lacunas", "walls", "edge", "params", "algorithm", "interior",
                "radial", "interior_params", "interior_algorithm", "level", "lacuna_scale", "face_lacuna_scale",
-               "gap_fraction", "notch_depth", "realization", "grade"},
+               "gap_fraction", "notch_depth", "realization", "grade", "cell_grade"},
               parse_as<BcifsInfillInput, parse_bcifs_infill_input>},
          })
       t.emplace(type.type, type);

@@ -465,6 +465,7 @@ def bcifs_infill(
     level: int = ...,
     equal_lacunas: bool = ...,
     grade: Mapping[str, Any] = ...,
+    cell_grade: Mapping[str, Any] = ...,
     walls: Literal["lacunar", "plain"] = ...,
     edge: str = ...,
     params: str = ...,
