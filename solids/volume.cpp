@@ -291,10 +291,23 @@ std::vector<Volume> mesh_offsets(const TriMesh& mesh, const VolumeOptions& optio
                        distances_mm, band, options);
 }
 
-Volume shell(const Volume& v, double thickness_mm) {
+namespace {
+
+void require_shell_thickness(double thickness_mm) {
   if (!(thickness_mm > 0) || !std::isfinite(thickness_mm))
     throw InvalidInput("shell thickness must be a positive length in mm");
+}
+
+}  // namespace
+
+Volume shell(const Volume& v, double thickness_mm) {
+  require_shell_thickness(thickness_mm);
   return subtract(v, offset(v, -thickness_mm));
+}
+
+Volume shell(const Volume& v, double thickness_mm, const Volume& inward_offset) {
+  require_shell_thickness(thickness_mm);
+  return subtract(v, inward_offset);
 }
 
 }  // namespace lacuna

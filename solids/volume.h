@@ -71,5 +71,7 @@ std::vector<Volume> mesh_offsets(const TriMesh& closed_mesh, const VolumeOptions
 
 // The solid minus its inward offset: a hollow part with walls of the given thickness (mm > 0).
 Volume shell(const Volume& v, double thickness_mm);
+// The same with that inward offset made already (offsets() of v, or mesh_offsets() of its mesh).
+Volume shell(const Volume& v, double thickness_mm, const Volume& inward_offset);
 
 }  // namespace lacuna

@@ -67,17 +67,18 @@ std::string distanced_operand(const OperationSpec& op) {
   return {};
 }
 
-// The operations whose offsets come from an input's own mesh, each with that mesh.
-std::map<std::string, const TriMesh*> mesh_offset_operations(const Recipe& recipe, const Plan& plan,
-                                                             const BuiltInputs& inputs) {
-  std::map<std::string, const TriMesh*> out;
+// The operations whose offsets come from an input's own mesh.
+std::set<std::string> operations_on_lone_meshes(const Recipe& recipe, const Plan& plan, const BuiltInputs& inputs) {
+  std::set<std::string> out;
   for (const std::string& name : plan.operations) {
     const std::string operand = distanced_operand(operation_named(recipe, name).spec);
-    if (operand.empty()) continue;
-    if (const TriMesh* mesh = lone_closed_mesh(plan, inputs, operand)) out[name] = mesh;
+    if (!operand.empty() && lone_closed_mesh(plan, inputs, operand)) out.insert(name);
   }
   return out;
 }
+
+std::map<std::string, ObjectExtent> extents_of(const Recipe& recipe, const Plan& plan, const BuiltInputs& inputs,
+                                               const std::set<std::string>& from_mesh);
 
 // The share of a box's height inside the slab's reach (1 without a slab).
 double slab_share(const Box3& box, const ZSlab* slab, double band) {
@@ -197,8 +198,14 @@ MemoryNeed estimate(const Recipe& recipe, const Plan& plan, const std::map<std::
 }  // namespace
 
 std::map<std::string, ObjectExtent> object_extents(const Recipe& recipe, const Plan& plan, const BuiltInputs& inputs) {
+  return extents_of(recipe, plan, inputs, operations_on_lone_meshes(recipe, plan, inputs));
+}
+
+namespace {
+
+std::map<std::string, ObjectExtent> extents_of(const Recipe& recipe, const Plan& plan, const BuiltInputs& inputs,
+                                               const std::set<std::string>& from_mesh) {
   const double h = recipe.voxel_size_mm, band = h * recipe.band_voxels;
-  const std::map<std::string, const TriMesh*> from_mesh = mesh_offset_operations(recipe, plan, inputs);
   std::map<std::string, ObjectExtent> extents;
   // A rasterized input equals the whole run's a band inside the slab (its faces' band); a level set
   // remade from a surface (offsets, shells, infills) needs its operand right out to the distance it
@@ -241,6 +248,8 @@ std::map<std::string, ObjectExtent> object_extents(const Recipe& recipe, const P
   return extents;
 }
 
+}  // namespace
+
 Volume Evaluation::take(const std::string& name) {
   Volume v = volumes.at(name);
   if (--uses[name] == 0) volumes.erase(name);
@@ -250,10 +259,9 @@ Volume Evaluation::take(const std::string& name) {
 MemoryEstimator::MemoryEstimator(const Recipe& recipe, const Plan& plan, const BuiltInputs& inputs)
     : recipe_(recipe),
       plan_(plan),
-      extents_(object_extents(recipe, plan, inputs)),
-      inputs_(input_estimates(recipe, plan, inputs, VolumeOptions{recipe.voxel_size_mm, recipe.band_voxels})) {
-  for (const auto& entry : mesh_offset_operations(recipe, plan, inputs)) from_mesh_.insert(entry.first);
-}
+      from_mesh_(operations_on_lone_meshes(recipe, plan, inputs)),
+      extents_(extents_of(recipe, plan, inputs, from_mesh_)),
+      inputs_(input_estimates(recipe, plan, inputs, VolumeOptions{recipe.voxel_size_mm, recipe.band_voxels})) {}
 
 MemoryNeed MemoryEstimator::need(const ZSlab* slab) const {
   return estimate(recipe_, plan_, inputs_, VolumeOptions{recipe_.voxel_size_mm, recipe_.band_voxels}, extents_,
@@ -319,14 +327,14 @@ Evaluation evaluate(const Recipe& recipe, const Plan& plan, const BuiltInputs& i
                                       });
   }
   timer.start("combine");
-  const std::map<std::string, const TriMesh*> from_mesh = mesh_offset_operations(recipe, plan, inputs);
   for (const std::string& name : plan.operations) {
     throw_if_cancelled(sink);
     const RecipeOperation& op = operation_named(recipe, name);
     const std::string where = recipe.file + ": " + op.json_path;
     // Offsets of an input's own mesh (whole, made once for every slab of a streamed run), or null.
-    const auto mesh_it = from_mesh.find(name);
-    const TriMesh* mesh = mesh_it == from_mesh.end() ? nullptr : mesh_it->second;
+    const TriMesh* mesh = estimator.mesh_offset_operations().count(name)
+                              ? &inputs.at(distanced_operand(op.spec)).geometry.solids.front()
+                              : nullptr;
     auto offsets_of_mesh = [&](const std::vector<double>& distances_mm) {
       std::vector<Volume> whole;
       if (options.slab && options.mesh_offsets) {
@@ -362,8 +370,7 @@ Evaluation evaluate(const Recipe& recipe, const Plan& plan, const BuiltInputs& i
     } else if (const auto* shell = std::get_if<ShellOperation>(&op.spec)) {
       v = result.take(shell->of);
       if (mesh) {
-        if (!(shell->thickness_mm > 0)) throw InvalidInput(where + ": shell thickness must be a positive length in mm");
-        v = subtract(v, offsets_of_mesh({-shell->thickness_mm}).front());
+        v = lacuna::shell(v, shell->thickness_mm, offsets_of_mesh({-std::fabs(shell->thickness_mm)}).front());
       } else {
         detail::require_surface_memory(v, budget, where, vopt);
         v = lacuna::shell(v, shell->thickness_mm);

@@ -77,13 +77,15 @@ class MemoryEstimator {
   // The most any of the slabs needs, or the whole part when there are none.
   uint64_t bytes(const std::vector<ZSlab>& slabs = {}) const;
   const std::map<std::string, ObjectExtent>& extents() const { return extents_; }
+  // The offset, shell and infill operations that distance an input's own closed mesh (mesh_offsets).
+  const std::set<std::string>& mesh_offset_operations() const { return from_mesh_; }
 
  private:
   const Recipe& recipe_;
   const Plan& plan_;
+  std::set<std::string> from_mesh_;  // operations whose offsets come from an input's own mesh
   std::map<std::string, ObjectExtent> extents_;
   std::map<std::string, MemoryEstimate> inputs_;
-  std::set<std::string> from_mesh_;  // operations whose offsets come from an input's own mesh
 };
 
 // Voxelizes the planned inputs and evaluates the planned operations. Throws ResourceLimit, before
