@@ -6,10 +6,10 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 build="${1:-build}"
 mkdir -p samples/pictures
-# Parts whose structure is inside a skin are shown cut at half their height.
+# Parts whose structure is inside a skin are shown cut at half their height (the rabbit at 0.3, through its body).
 for entry in menger_sponge takagi_nurbs_shell lacunar_hexagon_plate lacunar_cell hilbert_sphere sierpinski_torus \
              voronoi_foam:0.5 porous_egg:0.5 lacunar_panel egg_infill:0.5 lattice_block lacunar_hexahedron:0.5 \
-             lacunar_egg:0.5; do
+             lacunar_egg:0.5 bunny lacunar_bunny:0.3; do
   s="${entry%%:*}"
   args=()
   [ "$entry" != "$s" ] && args=(--section "${entry#*:}")

@@ -191,6 +191,31 @@ INSTANTIATE_TEST_SUITE_P(Samples, Sample, ::testing::ValuesIn(sample_names()),
                            return name;
                          });
 
+// The animal hull that lacunar_bunny imports is the rabbit samples/bunny.json builds: the shipped mesh
+// passes the check and is that recipe's part (same components and genus, volume within 0.1 %, box
+// within the recipe's voxel of 0.4 mm), so the file's origin stays true as the meshing changes.
+TEST(Samples, ShippedBunnyHullIsTheBunnyRecipesPart) {
+  TempDir dir;
+  const fs::path samples = fs::path(LACUNA_SOURCE_DIR) / "samples";
+  Result r = lacuna("run " + quote((samples / "bunny.json").string()) + " -o " + quote((dir / "out").string()) +
+                        " --json --quiet",
+                    dir.path());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json part = nlohmann::json::parse(r.out)["outputs"][0];
+  Result c = lacuna("check --json " + quote((samples / "meshes" / "bunny_hull.stl").string()), dir.path());
+  ASSERT_EQ(c.code, 0) << c.out << c.err;
+  const nlohmann::json hull = nlohmann::json::parse(c.out);
+  EXPECT_EQ(hull["components"], part["components"]);
+  EXPECT_EQ(hull["genus"], part["genus"]);
+  const double volume = part["volume_mm3"].get<double>();
+  EXPECT_GT(volume, 1e4);  // a 48 mm rabbit, not an empty or degenerate part
+  EXPECT_NEAR(hull["volume_mm3"].get<double>(), volume, 1e-3 * volume);
+  for (const char* end : {"min", "max"})
+    for (int k = 0; k < 3; ++k)
+      EXPECT_NEAR(hull["bounding_box_mm"][end][k].get<double>(), part["bounding_box_mm"][end][k].get<double>(), 0.4)
+          << end << " " << k;
+}
+
 // --- determinism -------------------------------------------------------------------------------
 
 const char* kSmallRecipe = R"({
