@@ -1129,18 +1129,14 @@ void simplify_region(RegionSimplifier& simplifier, Load&& load, SimplifyStats& s
     // A block's bolder quadric bound meets the walls across a thin part more often; its region is
     // tried again the fast way within the plain bound (as the pass across the blocks runs), and
     // only then, if that fails too, guarded.
-    bool done = false;
-    if (simplifier.bold()) {
+    const bool bold = simplifier.bold();
+    auto run_within_deviation = [&](bool guarded) {
       load();
       simplifier.keep_quadric_within_deviation();
-      simplifier.run(false);
-      done = simplifier.verify();
-    }
-    if (!done) {
-      load();
-      simplifier.keep_quadric_within_deviation();
-      simplifier.run(true);
-    }
+      simplifier.run(guarded);
+    };
+    if (bold) run_within_deviation(false);
+    if (!bold || !simplifier.verify()) run_within_deviation(true);
   }
   stats.collapses += simplifier.collapses();
   stats.rejected_by_intersection += simplifier.rejected_by_intersection();

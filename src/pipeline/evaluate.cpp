@@ -67,18 +67,19 @@ std::string distanced_operand(const OperationSpec& op) {
   return {};
 }
 
-// The operations whose offsets come from an input's own mesh.
-std::set<std::string> operations_on_lone_meshes(const Recipe& recipe, const Plan& plan, const BuiltInputs& inputs) {
-  std::set<std::string> out;
+// The operations whose offsets come from an input's own mesh, each with that mesh.
+MeshOffsetOperations operations_on_lone_meshes(const Recipe& recipe, const Plan& plan, const BuiltInputs& inputs) {
+  MeshOffsetOperations out;
   for (const std::string& name : plan.operations) {
     const std::string operand = distanced_operand(operation_named(recipe, name).spec);
-    if (!operand.empty() && lone_closed_mesh(plan, inputs, operand)) out.insert(name);
+    if (operand.empty()) continue;
+    if (const TriMesh* mesh = lone_closed_mesh(plan, inputs, operand)) out[name] = mesh;
   }
   return out;
 }
 
 std::map<std::string, ObjectExtent> extents_of(const Recipe& recipe, const Plan& plan, const BuiltInputs& inputs,
-                                               const std::set<std::string>& from_mesh);
+                                               const MeshOffsetOperations& from_mesh);
 
 // The share of a box's height inside the slab's reach (1 without a slab).
 double slab_share(const Box3& box, const ZSlab* slab, double band) {
@@ -113,7 +114,7 @@ std::map<std::string, MemoryEstimate> input_estimates(const Recipe& recipe, cons
 // Memory for everything the plan builds, refused before any large allocation.
 MemoryNeed estimate(const Recipe& recipe, const Plan& plan, const std::map<std::string, MemoryEstimate>& input_estimate,
                   const VolumeOptions& vopt, const std::map<std::string, ObjectExtent>& extents,
-                  const std::set<std::string>& from_mesh, const ZSlab* slab) {
+                  const MeshOffsetOperations& from_mesh, const ZSlab* slab) {
   struct Object {
     double area = 0;
     Box3 box;
@@ -204,7 +205,7 @@ std::map<std::string, ObjectExtent> object_extents(const Recipe& recipe, const P
 namespace {
 
 std::map<std::string, ObjectExtent> extents_of(const Recipe& recipe, const Plan& plan, const BuiltInputs& inputs,
-                                               const std::set<std::string>& from_mesh) {
+                                               const MeshOffsetOperations& from_mesh) {
   const double h = recipe.voxel_size_mm, band = h * recipe.band_voxels;
   std::map<std::string, ObjectExtent> extents;
   // A rasterized input equals the whole run's a band inside the slab (its faces' band); a level set
@@ -332,9 +333,8 @@ Evaluation evaluate(const Recipe& recipe, const Plan& plan, const BuiltInputs& i
     const RecipeOperation& op = operation_named(recipe, name);
     const std::string where = recipe.file + ": " + op.json_path;
     // Offsets of an input's own mesh (whole, made once for every slab of a streamed run), or null.
-    const TriMesh* mesh = estimator.mesh_offset_operations().count(name)
-                              ? &inputs.at(distanced_operand(op.spec)).geometry.solids.front()
-                              : nullptr;
+    const auto mesh_it = estimator.mesh_offset_operations().find(name);
+    const TriMesh* mesh = mesh_it == estimator.mesh_offset_operations().end() ? nullptr : mesh_it->second;
     auto offsets_of_mesh = [&](const std::vector<double>& distances_mm) {
       std::vector<Volume> whole;
       if (options.slab && options.mesh_offsets) {
@@ -370,7 +370,7 @@ Evaluation evaluate(const Recipe& recipe, const Plan& plan, const BuiltInputs& i
     } else if (const auto* shell = std::get_if<ShellOperation>(&op.spec)) {
       v = result.take(shell->of);
       if (mesh) {
-        v = lacuna::shell(v, shell->thickness_mm, offsets_of_mesh({-std::fabs(shell->thickness_mm)}).front());
+        v = lacuna::shell(v, shell->thickness_mm, offsets_of_mesh({-shell->thickness_mm}).front());
       } else {
         detail::require_surface_memory(v, budget, where, vopt);
         v = lacuna::shell(v, shell->thickness_mm);

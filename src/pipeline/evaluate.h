@@ -5,7 +5,6 @@
 
 #include <cstdint>
 #include <map>
-#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -69,6 +68,9 @@ struct MemoryNeed {
   uint64_t bytes() const { return grid_bytes + mesh_bytes; }
 };
 
+// Operations that distance an input's own closed mesh, by name, each with that mesh.
+using MeshOffsetOperations = std::map<std::string, const TriMesh*>;
+
 class MemoryEstimator {
  public:
   MemoryEstimator(const Recipe& recipe, const Plan& plan, const BuiltInputs& inputs);
@@ -77,13 +79,14 @@ class MemoryEstimator {
   // The most any of the slabs needs, or the whole part when there are none.
   uint64_t bytes(const std::vector<ZSlab>& slabs = {}) const;
   const std::map<std::string, ObjectExtent>& extents() const { return extents_; }
-  // The offset, shell and infill operations that distance an input's own closed mesh (mesh_offsets).
-  const std::set<std::string>& mesh_offset_operations() const { return from_mesh_; }
+  // The offset, shell and infill operations that distance an input's own closed mesh (mesh_offsets),
+  // each with that mesh.
+  const MeshOffsetOperations& mesh_offset_operations() const { return from_mesh_; }
 
  private:
   const Recipe& recipe_;
   const Plan& plan_;
-  std::set<std::string> from_mesh_;  // operations whose offsets come from an input's own mesh
+  MeshOffsetOperations from_mesh_;
   std::map<std::string, ObjectExtent> extents_;
   std::map<std::string, MemoryEstimate> inputs_;
 };
