@@ -20,9 +20,9 @@ out="$(mktemp -d)"
 trap 'rm -rf "$out"' EXIT
 echo "| sample | file | plain triangles | plain size | plain load | plain run | compact triangles | compact size | compact load | compact run |"
 echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
+modes=(plain compact)
+[ "${COMPACT_ONLY:-0}" = 1 ] && modes=(compact)
 for s in "${samples[@]}"; do
-  modes=(plain compact)
-  [ "${COMPACT_ONLY:-0}" = 1 ] && modes=(compact)
   for mode in "${modes[@]}"; do
     args=()
     [ "$mode" = plain ] && args=(--simplify 0)
