@@ -490,7 +490,16 @@ TEST(Simplify, ChunkedCheckReadsAsTheWholeCheck) {
   };
   std::stable_sort(cup.triangles.begin(), cup.triangles.end(),
                    [&](const auto& a, const auto& b) { return off_axis(a) < off_axis(b); });
-  for (double height : {2.0, 3.0, 4.0}) {
+  // Bands by centroid, each lying above every triangle two bands below it (as the streamed check's
+  // chunks are grown to): a triangle reaches 2/3 of its height from its centroid, so a band must be
+  // over 4/3 of the tallest triangle; the cup stays taller than two bands.
+  double tallest = 0;
+  for (const auto& t : cup.triangles) {
+    const double z[3] = {cup.positions_mm[t[0]].z, cup.positions_mm[t[1]].z, cup.positions_mm[t[2]].z};
+    tallest = std::max(tallest, std::max({z[0], z[1], z[2]}) - std::min({z[0], z[1], z[2]}));
+  }
+  ASSERT_LT(4.0 / 3.0 * tallest, 4.0);
+  for (double height : {4.0, 5.0, 6.0}) {
     const MeshCheckReport chunked = chunked_check(cup, height);
     EXPECT_EQ(chunked.inward_components, 0u) << "bands of " << height << " mm";
     expect_same_report(chunked, check_mesh(cup), "cup, bands of " + std::to_string(height) + " mm");
