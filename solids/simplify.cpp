@@ -336,17 +336,7 @@ class RegionSimplifier {
       if (!vertex_alive_[e.keep] || !vertex_alive_[e.drop] || uint16_t(version_[e.keep]) != e.keep_version ||
           uint16_t(version_[e.drop]) != e.drop_version)
         continue;
-      // A collapse refused for the shape of its triangles (too thin, or turned too far) is tried again
-      // with the new vertex at either end of the edge when the edge may move: on a cylinder the
-      // quadric's minimiser sits mid-edge, which thins the triangles across the axis, while an end
-      // keeps the ring's spacing (a strut of lattice_block: 68 890 -> 48 528 triangles).
-      bool done = false;
-      for (placement_ = Placement::kBest; !done; placement_ = Placement(int(placement_) + 1)) {
-        shape_refused_ = false;
-        done = collapse(e.keep, e.drop);
-        if (done || !shape_refused_ || locked_[e.keep] || placement_ == Placement::kAtDrop) break;
-      }
-      if (!done) continue;
+      if (!collapse(e.keep, e.drop)) continue;
       ++collapses_;
       for (uint32_t w : keep_ring_after_) consider(e.keep, w);
     }
@@ -787,10 +777,8 @@ class RegionSimplifier {
 
     // A free vertex goes where the quadric is least among the positions that give the enclosed
     // volume its due (the volume before plus the two ends' debts; the new fan's volume is linear
-    // in its position), unless that costs more than the tolerance; then to the plain minimiser. On a
-    // retry (placement_) it goes to one end of the edge instead.
+    // in its position), unless that costs more than the tolerance; then to the plain minimiser.
     const Quadric q = quadric_[keep] + quadric_[drop];
-    Vec3d target = first_target(keep, drop, q);
     const Vec3d mid = (pos_[keep] + pos_[drop]) * 0.5;
     Vec3d n;
     double old6 = 0;
@@ -804,57 +792,66 @@ class RegionSimplifier {
     // a curved one (a flat face stays flat, to the bit, for node sets and slicers).
     const double owed6 = debt_[keep] + debt_[drop];
     const double paid6 = q.flat() ? 0.0 : owed6;
-    if (!locked_[keep] && placement_ != Placement::kBest) {
-      target = placement_ == Placement::kAtKeep ? pos_[keep] : pos_[drop];  // float already, as every position
-      if (!box_.strictly_inside(target) || q.error(target) > quadric_tolerance2_) return false;
-    } else if (!locked_[keep]) {
-      Vec3d volume_target;
-      if (q.minimiser_on_plane(mid, n, old6 + paid6 + dot(n, mid), volume_target) &&
-          q.error(round_to_output(volume_target)) <= quadric_tolerance2_)
-        target = volume_target;
-      target = round_to_output(target);
-      if (!box_.strictly_inside(target) || q.error(target) > quadric_tolerance2_) return false;
-    } else if (!box_.strictly_inside(target)) {
-      return false;
-    }
-    const bool keep_moves = target != pos_[keep];
-    // The triangles that change: drop's (renamed), and keep's when keep moves. None may be worse
-    // shaped than the worst it replaces unless it stays above kMinQuality: exact tests keep even a
-    // needle valid, but slicers, viewers and meshers recompute its normal in float and trip on it.
-    double old_quality2 = std::min(quality2_[t1], quality2_[t2]);
-    double new_quality2 = HUGE_VAL;
-    changed_.clear();
-    changed_quality2_.clear();
-    changed_ids_.clear();
-    changed_pos_.clear();
-    changed_box_.clear();
-    for (uint32_t c : new_fan_) {
-      const uint32_t t = tri_of(c);
-      const auto& old = tri_[t];
-      const bool of_drop = old[0] == drop || old[1] == drop || old[2] == drop;
-      if (!of_drop && !keep_moves) continue;
-      const std::array<uint32_t, 3> ids{rename(old[0]), rename(old[1]), rename(old[2])};
-      const std::array<Vec3d, 3> p{at(ids[0], keep, target), at(ids[1], keep, target), at(ids[2], keep, target)};
-      if (exact::collinear(p[0], p[1], p[2])) return false;
-      const Vec3d n_old = cross(pos_[old[1]] - pos_[old[0]], pos_[old[2]] - pos_[old[0]]);
-      const Vec3d n_new = cross(p[1] - p[0], p[2] - p[0]);
-      if (dot(n_old, n_new) <= cos_normal_ * norm(n_old) * norm(n_new)) {
-        shape_refused_ = true;
-        return false;
+    enum class Shape { kFine, kMisshapen, kRefused };
+    Vec3d target;
+    bool keep_moves = false;
+    // The triangles that change at `placement`: drop's (renamed), and keep's when keep moves. None
+    // may turn further than the normal bound, nor be worse shaped than the worst it replaces unless
+    // it stays above kMinQuality: exact tests keep even a needle valid, but slicers, viewers and
+    // meshers recompute its normal in float and trip on it.
+    auto shape_at = [&](Placement placement) {
+      target = first_target(keep, drop, q);
+      if (!locked_[keep] && placement != Placement::kBest) {
+        target = placement == Placement::kAtKeep ? pos_[keep] : pos_[drop];  // float already, as every position
+        if (!box_.strictly_inside(target) || q.error(target) > quadric_tolerance2_) return Shape::kRefused;
+      } else if (!locked_[keep]) {
+        Vec3d volume_target;
+        if (q.minimiser_on_plane(mid, n, old6 + paid6 + dot(n, mid), volume_target) &&
+            q.error(round_to_output(volume_target)) <= quadric_tolerance2_)
+          target = volume_target;
+        target = round_to_output(target);
+        if (!box_.strictly_inside(target) || q.error(target) > quadric_tolerance2_) return Shape::kRefused;
+      } else if (!box_.strictly_inside(target)) {
+        return Shape::kRefused;
       }
-      old_quality2 = std::min(old_quality2, quality2_[t]);
-      changed_quality2_.push_back(quality2(p[0], p[1], p[2]));
-      new_quality2 = std::min(new_quality2, changed_quality2_.back());
-      changed_.push_back(t);
-      changed_ids_.push_back(ids);
-      changed_pos_.push_back(p);
-      changed_box_.push_back(tri_box(p));
+      keep_moves = target != pos_[keep];
+      double old_quality2 = std::min(quality2_[t1], quality2_[t2]);
+      double new_quality2 = HUGE_VAL;
+      changed_.clear();
+      changed_quality2_.clear();
+      changed_ids_.clear();
+      changed_pos_.clear();
+      changed_box_.clear();
+      for (uint32_t c : new_fan_) {
+        const uint32_t t = tri_of(c);
+        const auto& old = tri_[t];
+        const bool of_drop = old[0] == drop || old[1] == drop || old[2] == drop;
+        if (!of_drop && !keep_moves) continue;
+        const std::array<uint32_t, 3> ids{rename(old[0]), rename(old[1]), rename(old[2])};
+        const std::array<Vec3d, 3> p{at(ids[0], keep, target), at(ids[1], keep, target), at(ids[2], keep, target)};
+        if (exact::collinear(p[0], p[1], p[2])) return Shape::kRefused;
+        const Vec3d n_old = cross(pos_[old[1]] - pos_[old[0]], pos_[old[2]] - pos_[old[0]]);
+        const Vec3d n_new = cross(p[1] - p[0], p[2] - p[0]);
+        if (dot(n_old, n_new) <= cos_normal_ * norm(n_old) * norm(n_new)) return Shape::kMisshapen;
+        old_quality2 = std::min(old_quality2, quality2_[t]);
+        changed_quality2_.push_back(quality2(p[0], p[1], p[2]));
+        new_quality2 = std::min(new_quality2, changed_quality2_.back());
+        changed_.push_back(t);
+        changed_ids_.push_back(ids);
+        changed_pos_.push_back(p);
+        changed_box_.push_back(tri_box(p));
+      }
+      return new_quality2 < std::min(kMinQuality * kMinQuality, old_quality2) ? Shape::kMisshapen : Shape::kFine;
+    };
+    // Misshapen at the best position, a free vertex is tried where keep is, then where drop is: on a
+    // cylinder the quadric's minimiser sits mid-edge, which thins the triangles across the axis,
+    // while an end keeps the ring's spacing (lattice_block: 68 890 -> 48 528 triangles).
+    Shape shape = Shape::kRefused;
+    for (Placement placement : {Placement::kBest, Placement::kAtKeep, Placement::kAtDrop}) {
+      shape = shape_at(placement);
+      if (shape != Shape::kMisshapen || locked_[keep]) break;
     }
-
-    if (new_quality2 < std::min(kMinQuality * kMinQuality, old_quality2)) {
-      shape_refused_ = true;
-      return false;
-    }
+    if (shape != Shape::kFine) return false;
 
     // Pairs sharing a vertex whose fan is a graph over a coordinate plane meet only in what they
     // share. keep's new fan is checked whole; a neighbour whose fan was a graph stays one when
@@ -1095,11 +1092,8 @@ class RegionSimplifier {
 
   double tolerance2_ = 0, quadric_tolerance2_ = 0, max_deviation_ = 0, cos_normal_ = 0;
   bool guarded_ = false;
-  // Where a free vertex goes: the best position (see collapse), or where keep or drop is; and whether
-  // the last try was refused for its triangles' shapes only.
+  // Where a collapse puts a free vertex: the best position (see collapse), or where keep or drop is.
   enum class Placement { kBest, kAtKeep, kAtDrop };
-  Placement placement_ = Placement::kBest;
-  bool shape_refused_ = false;
   RegionBox box_;
   std::vector<uint32_t> global_vertex_;
   std::vector<std::array<uint32_t, 3>> tri_;
