@@ -211,6 +211,14 @@ int run_bench(int argc, char** argv) {
     result["simplify_input_triangles"] = stats.input_triangles;
     result["simplify_merged_triangles"] = stats.merged_triangles;
     result["simplify_regions_redone"] = stats.regions_redone;
+    result["simplify_regions_guarded"] = stats.regions_guarded;
+    result["simplify_collapses"] = stats.collapses;
+    result["simplify_thread_seconds"] = {{"extract", stats.extract_thread_seconds},
+                                         {"run", stats.run_thread_seconds},
+                                         {"verify", stats.verify_thread_seconds},
+                                         {"redo", stats.redo_thread_seconds}};
+    result["simplify_wall_seconds"] = {
+        {"blocks", stats.blocks_seconds}, {"assemble", stats.assemble_seconds}, {"pass", stats.pass_seconds}};
     auto t5 = std::chrono::steady_clock::now();
     MeshCheckReport check = check_mesh(compact);
     result["simplified_check_seconds"] = seconds_since(t5);

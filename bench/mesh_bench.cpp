@@ -61,6 +61,9 @@ int run_bench(int argc, char** argv) {
     result["rejected_by_intersection"] = stats.rejected_by_intersection;
     result["regions"] = stats.regions;
     result["regions_redone"] = stats.regions_redone;
+    result["regions_guarded"] = stats.regions_guarded;
+    result["simplify_thread_seconds"] = {
+        {"run", stats.run_thread_seconds}, {"verify", stats.verify_thread_seconds}, {"redo", stats.redo_thread_seconds}};
   }
   if (!other_path.empty()) {
     const TriMesh other = read_mesh(other_path);

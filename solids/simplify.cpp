@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <numeric>
 #include <functional>
@@ -22,6 +23,15 @@
 
 namespace lacuna {
 namespace {
+
+// Seconds since it was made (for SimplifyStats' time breakdown).
+class Stopwatch {
+ public:
+  double seconds() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
+
+ private:
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
 
 constexpr uint32_t kNone = UINT32_MAX;
 constexpr int kBlockVoxels = 32;  // the blocks a volume's surface is simplified in
@@ -1137,13 +1147,30 @@ class RegionSimplifier {
   uint64_t collapses_ = 0, rejected_intersection_ = 0;
 };
 
+// Adds what one region (or block) counted and timed to the totals.
+void add_region_stats(SimplifyStats& total, const SimplifyStats& region) {
+  total.collapses += region.collapses;
+  total.rejected_by_intersection += region.rejected_by_intersection;
+  total.regions_redone += region.regions_redone;
+  total.regions_guarded += region.regions_guarded;
+  total.run_thread_seconds += region.run_thread_seconds;
+  total.verify_thread_seconds += region.verify_thread_seconds;
+  total.redo_thread_seconds += region.redo_thread_seconds;
+}
+
 // Simplifies one region the fast way and verifies the result; redoes it guarded when the
 // verification finds a crossing. `load` (re)loads the region's input.
 template <class Load>
 void simplify_region(RegionSimplifier& simplifier, Load&& load, SimplifyStats& stats) {
+  const Stopwatch first;
   load();
   simplifier.run(false);
-  if (!simplifier.verify()) {
+  stats.run_thread_seconds += first.seconds();
+  const Stopwatch verifying;
+  const bool verified = simplifier.verify();
+  stats.verify_thread_seconds += verifying.seconds();
+  if (!verified) {
+    const Stopwatch redo;
     ++stats.regions_redone;
     // A block's bolder quadric bound meets the walls across a thin part more often; its region is
     // tried again the fast way within the plain bound (as the pass across the blocks runs), and
@@ -1155,7 +1182,11 @@ void simplify_region(RegionSimplifier& simplifier, Load&& load, SimplifyStats& s
       simplifier.run(guarded);
     };
     if (bold) run_within_deviation(false);
-    if (!bold || !simplifier.verify()) run_within_deviation(true);
+    if (!bold || !simplifier.verify()) {
+      ++stats.regions_guarded;
+      run_within_deviation(true);
+    }
+    stats.redo_thread_seconds += redo.seconds();
   }
   stats.collapses += simplifier.collapses();
   stats.rejected_by_intersection += simplifier.rejected_by_intersection();
@@ -1296,9 +1327,7 @@ void simplify_pass(Vertices& vertices, std::vector<std::array<uint32_t, 3>>& tri
     result.insert(result.end(), out[r].begin(), out[r].end());
     if (scope.apply_debt)
       for (const auto& [v, change] : debt_changes[r]) vertices.debt6[v] += change;
-    stats.collapses += region_stats[r].collapses;
-    stats.rejected_by_intersection += region_stats[r].rejected_by_intersection;
-    stats.regions_redone += region_stats[r].regions_redone;
+    add_region_stats(stats, region_stats[r]);
     ++stats.regions;
   }
   if (!out_triangles) triangles.swap(replaced);
@@ -1384,7 +1413,9 @@ std::vector<BlockResult> simplified_blocks(const BlockExtractor& extractor, cons
       RegionSimplifier& simplifier = simplifiers.local();
       SurfaceBlock& block = surface_blocks.local();
       for (size_t i = range.begin(); i != range.end(); ++i) {
+        const Stopwatch extracting;
         extractor.extract(which[i], block);
+        block_stats[i].extract_thread_seconds = extracting.seconds();
         block_stats[i].input_triangles = block.piece_triangles;
         block_stats[i].merged_triangles = block.triangles.size();
         if (!block.triangles.empty()) {
@@ -1399,9 +1430,8 @@ std::vector<BlockResult> simplified_blocks(const BlockExtractor& extractor, cons
   for (size_t i = 0; i < blocks; ++i) {
     stats.input_triangles += block_stats[i].input_triangles;
     stats.merged_triangles += block_stats[i].merged_triangles;
-    stats.collapses += block_stats[i].collapses;
-    stats.rejected_by_intersection += block_stats[i].rejected_by_intersection;
-    stats.regions_redone += block_stats[i].regions_redone;
+    stats.extract_thread_seconds += block_stats[i].extract_thread_seconds;
+    add_region_stats(stats, block_stats[i]);
     stats.regions += results[i].triangles.empty() ? 0 : 1;
   }
   return results;
@@ -1436,7 +1466,10 @@ TriMesh extract_simplified_surface(const Volume& volume, const SimplifyOptions& 
   const size_t blocks = extractor.block_count();
   std::vector<size_t> all(blocks);
   std::iota(all.begin(), all.end(), size_t(0));
+  const Stopwatch blocks_time;
   std::vector<BlockResult> results = simplified_blocks(extractor, all, options, stats);
+  stats.blocks_seconds = blocks_time.seconds();
+  const Stopwatch assemble_time;
   std::vector<const std::vector<uint64_t>*> keys(blocks);
   for (size_t i = 0; i < blocks; ++i) keys[i] = &results[i].keys;
   std::vector<std::vector<uint32_t>> global;
@@ -1478,11 +1511,14 @@ TriMesh extract_simplified_surface(const Volume& volume, const SimplifyOptions& 
   release_free_memory();
   // Across the block faces: regions of the same size, shifted by half a block, so each holds a
   // meeting point of eight blocks in its middle.
+  stats.assemble_seconds = assemble_time.seconds();
   if (!triangles.empty()) {
+    const Stopwatch pass_time;
     Box3 box;
     for (const Vec3d& p : positions) box.expand(p);
     check_lattice_reach(box, volume.voxel_size_mm());
     simplify_pass(vertices, triangles, block_lattice(volume.voxel_size_mm()), options, stats);
+    stats.pass_seconds = pass_time.seconds();
   }
   // The quadrics and debts are done with: freed before the compact copy is made (a fifth of the
   // surface's peak memory on the lacunar egg benchmark).

@@ -36,7 +36,21 @@ struct SimplifyStats {
   uint64_t collapses = 0;
   uint64_t rejected_by_intersection = 0;  // collapses the exact guard refused
   uint64_t regions = 0;                   // regions simplified (blocks and cross-block regions)
-  uint64_t regions_redone = 0;            // regions whose result failed verification and were redone guarded
+  uint64_t regions_redone = 0;            // regions whose result failed verification and were redone
+  uint64_t regions_guarded = 0;           // of those, the ones the plain bound did not mend: redone guarded
+  // Where the time went, in seconds summed over the threads (so on two busy cores about twice the
+  // wall time): extracting and merging the blocks' cubes; the regions' first runs (loading them and
+  // the collapses); their verifications; the redone regions' second and third runs (their first
+  // runs and verifications are counted in the two before).
+  double extract_thread_seconds = 0;
+  double run_thread_seconds = 0;
+  double verify_thread_seconds = 0;
+  double redo_thread_seconds = 0;
+  // extract_simplified_surface only, wall time: the blocks (extracted and simplified), putting their
+  // results together, and the pass across the blocks' faces.
+  double blocks_seconds = 0;
+  double assemble_seconds = 0;
+  double pass_seconds = 0;
 };
 
 // Simplifies a closed mesh to within the deviation. Every coordinate of the result is a float32

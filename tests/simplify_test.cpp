@@ -194,6 +194,8 @@ TEST(Simplify, ThinWallsNearBlockFacesStayApart) {
   // they share none with: the verification of that region finds it and the region is redone with
   // every collapse tested against the faces near it (so this test covers both ways of guarding).
   EXPECT_GT(stats.regions_redone, 0u);
+  EXPECT_GT(stats.regions_guarded, 0u);
+  EXPECT_LE(stats.regions_guarded, stats.regions_redone);
   EXPECT_GT(stats.rejected_by_intersection, 0u);
 }
 
