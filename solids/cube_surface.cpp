@@ -330,7 +330,67 @@ bool merged_triangles(const MergeInput& in, std::vector<std::array<uint8_t, 3>>&
     }
     if (order_count > 1) std::sort(order, order + order_count);
 
-    // The pieces' area-weighted normal and the pieces' boxes for the deviation tests.
+    // Where the patch is flat, the deviation tests below follow from exact orientations. Project
+    // along the axis k nearest the pieces' normal: when every piece and every new triangle turns
+    // the same way there, each surface is an orientation-preserving map of a disk onto the plane,
+    // covering each point as often as its boundary curve winds around it. The two curves differ
+    // only where a face-diagonal crossing d is left out between its neighbours a and b: by the
+    // triangle a d b, which lies in d's face, so on a face parallel to k it projects onto a line
+    // (no winding number changes) and on one orthogonal to k it is flat in the plane. So a
+    // point of either surface has a point of the other, or of such a triangle, on its line along
+    // k. All of them are linear on triangles of the patch's crossings, whose heights along k over
+    // one plane lie in a range W, so that point lies within W. A point of a triangle a d b lies
+    // within H of a d or d b, and of a b, H the largest distance from a left-out d to the
+    // segment between its neighbours (its height over a b bounds both); so does d. With W + H
+    // below the deviation (a margin for rounding), every point the tests below sample passes
+    // them (a point within the deviation of a triangle lies in its grown box and near its plane
+    // too), and facing is tested as there, against every piece: the candidate is the one those
+    // tests would take, found without them. The exact tests (collinear, crossing) still run.
+    int flat_axis = -1, flat_sign = 0;
+    {
+      Vec3d normal;
+      for (int t = 0; t < own_count; ++t) normal += near_own[t].normal_vector();
+      const int fk = std::fabs(normal.x) >= std::fabs(normal.y) && std::fabs(normal.x) >= std::fabs(normal.z)
+                         ? 0
+                         : (std::fabs(normal.y) >= std::fabs(normal.z) ? 1 : 2);
+      const int fi = (fk + 1) % 3, fj = (fk + 2) % 3, fs = normal[fk] > 0 ? 1 : -1;
+      bool flat = std::fabs(normal[fk]) > 0;
+      double h = 0;  // the largest H
+      for (int i = 0; i < patch.loop_length; ++i) {
+        const int d = patch.loop[i];
+        if (!is_face_diagonal(d) || ((in.kept_faces >> face_of_diagonal(d)) & 1)) continue;
+        const Vec3d& a = pos[patch.loop[(i + patch.loop_length - 1) % patch.loop_length]];
+        const Vec3d ab = pos[patch.loop[(i + 1) % patch.loop_length]] - a, ad = pos[d] - a;
+        const double len2 = dot(ab, ab);
+        const double t = len2 > 0 ? std::clamp(dot(ad, ab) / len2, 0.0, 1.0) : 0.0;
+        h = std::max(h, norm(ad - ab * t));
+      }
+      for (int t = 0; t < own_count && flat; ++t) {
+        const Vec3d &a = pos[own[t][0]], &b = pos[own[t][1]], &d = pos[own[t][2]];
+        if (exact::orient2d(a[fi], a[fj], b[fi], b[fj], d[fi], d[fj]) != fs) flat = false;
+      }
+      if (flat) {
+        Vec3d centre;
+        const int crossings = patch.loop_length + patch.interior_count;
+        for (int i = 0; i < patch.loop_length; ++i) centre += pos[patch.loop[i]];
+        for (int i = 0; i < patch.interior_count; ++i) centre += pos[patch.interior[i]];
+        centre = centre / double(crossings);
+        // The crossings' heights along k over the plane through the centre.
+        double lowest = HUGE_VAL, highest = -HUGE_VAL;
+        for (int i = 0; i < crossings; ++i) {
+          const Vec3d& q = pos[i < patch.loop_length ? patch.loop[i] : patch.interior[i - patch.loop_length]];
+          const double height = dot(normal, q - centre) / normal[fk];
+          lowest = std::min(lowest, height);
+          highest = std::max(highest, height);
+        }
+        flat = (highest - lowest) + h <= 0.999 * dev;
+      }
+      if (flat && !in.sampled_tests_only) {
+        flat_axis = fk;
+        flat_sign = fs;
+      }
+    }
+
     bool found = false;
     for (int o = 0; o < order_count && !found; ++o) {
       const auto& cand = candidates[size_t(order[o].index)];
@@ -341,10 +401,20 @@ bool merged_triangles(const MergeInput& in, std::vector<std::array<uint8_t, 3>>&
       for (int t = 0; t < m && ok; ++t)
         if (exact::collinear(pos[tris[t][0]], pos[tris[t][1]], pos[tris[t][2]])) ok = false;
       if (!ok) continue;
-      // The left-out crossings lie within the deviation of the new triangles.
       NearTriangle near_new[kMaxLoop - 2];
       for (int t = 0; t < m; ++t) near_new[t].set(pos, tris[t], dev);
-      for (int r = 0; r < removed_count && ok; ++r) {
+      bool proven = flat_axis >= 0;
+      for (int t = 0; t < m && proven; ++t) {
+        const int fi = (flat_axis + 1) % 3, fj = (flat_axis + 2) % 3;
+        const Vec3d &a = pos[tris[t][0]], &b = pos[tris[t][1]], &d = pos[tris[t][2]];
+        if (exact::orient2d(a[fi], a[fj], b[fi], b[fj], d[fi], d[fj]) != flat_sign) proven = false;
+        const Vec3d facing = near_new[t].normal_vector();
+        for (int u = 0; u < own_count && proven; ++u)
+          if (!(dot(facing, near_own[u].normal_vector()) > 0)) proven = false;
+      }
+      if (proven && in.proven_candidates) ++*in.proven_candidates;
+      // The left-out crossings lie within the deviation of the new triangles.
+      for (int r = 0; r < removed_count && ok && !proven; ++r) {
         bool near = false;
         for (int t = 0; t < m && !near; ++t) near = near_new[t].near(pos[removed[r]], dev);
         ok = near;
@@ -357,7 +427,7 @@ bool merged_triangles(const MergeInput& in, std::vector<std::array<uint8_t, 3>>&
           if ((!facing || dot(*facing, near_own[t].normal_vector()) > 0) && near_own[t].near(q, dev)) return true;
         return false;
       };
-      for (int t = 0; t < m && ok; ++t) {
+      for (int t = 0; t < m && ok && !proven; ++t) {
         const Vec3d &a = pos[tris[t][0]], &b = pos[tris[t][1]], &d = pos[tris[t][2]];
         const Vec3d facing = near_new[t].normal_vector();
         if (!near_pieces((a + b + d) / 3.0, &facing)) {

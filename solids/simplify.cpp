@@ -11,8 +11,11 @@
 #include <numeric>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <tuple>
+#include <type_traits>
 #include <unordered_map>
+#include <utility>
 
 #include "errors.h"
 #include "solids/exact.h"
@@ -226,10 +229,32 @@ struct BlockResult {
   int64_t origin_voxels[3] = {0, 0, 0};
   std::vector<Vec3d> positions;
   std::vector<uint64_t> keys;
-  std::vector<Quadric> quadrics;
+  std::vector<Quadric> quadrics;     // of the vertices with has_quadric, in their order
   std::vector<uint8_t> has_quadric;
   std::vector<double> debt6;
   std::vector<std::array<uint32_t, 3>> triangles;
+};
+
+// Constructs an element given no arguments as nothing: the element is left as the allocation left
+// it, so a large array's pages are first touched (and cleared by the kernel) where its elements are
+// written, in parallel, not by the vector's constructor on one thread. Others as std::allocator.
+template <class T>
+struct UnsetAllocator : std::allocator<T> {
+  template <class U>
+  struct rebind {
+    using other = UnsetAllocator<U>;
+  };
+  UnsetAllocator() = default;
+  template <class U>
+  UnsetAllocator(const UnsetAllocator<U>&) noexcept {}
+  template <class U>
+  void construct(U*) noexcept {
+    static_assert(std::is_trivially_copyable_v<U> && std::is_trivially_destructible_v<U>, "plain values only");
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
 };
 
 // The vertices of a global mesh between passes. debt6: six times the volume the surface owes
@@ -237,13 +262,17 @@ struct BlockResult {
 // collapse that may places its vertex to pay its two ends' debts.
 struct Vertices {
   std::vector<Vec3d> positions;
-  std::vector<Quadric> quadrics;
+  // Read only where has_quadric is set (written first): left unset by Vertices(n).
+  std::vector<Quadric, UnsetAllocator<Quadric>> quadrics;
   std::vector<uint8_t> has_quadric;
   std::vector<double> debt6;
   // When not empty: the order a region numbers its vertices in (by these keys, otherwise by index).
   std::vector<VertexOrder> order;
   explicit Vertices(size_t n) : positions(n), quadrics(n), has_quadric(n, 0), debt6(n, 0.0) {}
 };
+
+// A whole surface's triangles: resized unset, then filled in parallel.
+using TriangleList = std::vector<std::array<uint32_t, 3>, UnsetAllocator<std::array<uint32_t, 3>>>;
 
 // One region's piece of the mesh and the collapses in it. Everything is local: vertices and
 // triangles are renumbered, and only the region's own unlocked vertices are written back.
@@ -271,34 +300,33 @@ class RegionSimplifier {
 
   // Loads the given triangles of a global mesh; quadrics of vertices that carry one are taken,
   // the others summed from their local triangles.
-  void load_global(const RegionBox& box, const std::vector<std::array<uint32_t, 3>>& global_tris,
+  void load_global(const RegionBox& box, const std::array<uint32_t, 3>* global_tris,
                    const std::vector<uint32_t>& tri_ids, const Vertices& vertices) {
     box_ = box;
     const size_t nt = tri_ids.size();
+    // Each global vertex once (marked in local_of_, which is all kNone between loads), in the
+    // order the region numbers them: by index, or as the whole surface numbers them, so the region
+    // does what it does there.
+    if (local_of_.size() < vertices.positions.size()) local_of_.assign(vertices.positions.size(), kNone);
     global_vertex_.clear();
     for (uint32_t t : tri_ids)
-      for (uint32_t v : global_tris[t]) global_vertex_.push_back(v);
-    std::sort(global_vertex_.begin(), global_vertex_.end());
-    global_vertex_.erase(std::unique(global_vertex_.begin(), global_vertex_.end()), global_vertex_.end());
-    const size_t nv = global_vertex_.size();
-    tri_.resize(nt);
+      for (uint32_t v : global_tris[t])
+        if (local_of_[v] == kNone) {
+          local_of_[v] = 0;
+          global_vertex_.push_back(v);
+        }
     if (vertices.order.empty()) {
-      for (size_t i = 0; i < nt; ++i)
-        for (int k = 0; k < 3; ++k)
-          tri_[i][size_t(k)] = uint32_t(std::lower_bound(global_vertex_.begin(), global_vertex_.end(),
-                                                         global_tris[tri_ids[i]][size_t(k)]) -
-                                        global_vertex_.begin());
+      std::sort(global_vertex_.begin(), global_vertex_.end());
     } else {
-      // Numbered as the whole surface numbers them, so the region does what it does there.
       const std::vector<VertexOrder>& order = vertices.order;
-      auto before = [&](uint32_t a, uint32_t b) { return order[a] < order[b]; };
-      std::sort(global_vertex_.begin(), global_vertex_.end(), before);
-      for (size_t i = 0; i < nt; ++i)
-        for (int k = 0; k < 3; ++k)
-          tri_[i][size_t(k)] = uint32_t(std::lower_bound(global_vertex_.begin(), global_vertex_.end(),
-                                                         global_tris[tri_ids[i]][size_t(k)], before) -
-                                        global_vertex_.begin());
+      std::sort(global_vertex_.begin(), global_vertex_.end(), [&](uint32_t a, uint32_t b) { return order[a] < order[b]; });
     }
+    const size_t nv = global_vertex_.size();
+    for (size_t v = 0; v < nv; ++v) local_of_[global_vertex_[v]] = uint32_t(v);
+    tri_.resize(nt);
+    for (size_t i = 0; i < nt; ++i)
+      for (int k = 0; k < 3; ++k) tri_[i][size_t(k)] = local_of_[global_tris[tri_ids[i]][size_t(k)]];
+    for (uint32_t g : global_vertex_) local_of_[g] = kNone;
     pos_.resize(nv);
     quadric_.assign(nv, Quadric());
     own_quadric_.assign(nv, 0);
@@ -362,7 +390,7 @@ class RegionSimplifier {
   // of fixed cells, filled by counting.
   bool verify() {
     const size_t nt = tri_.size();
-    size_grid();
+    size_grid(kVerifyTrianglesPerCell);
     verify_boxes_.resize(nt);
     verify_start_.assign(size_t(cells_) * cells_ * cells_ + 1, 0);
     for (int pass = 0; pass < 2; ++pass) {
@@ -432,15 +460,29 @@ class RegionSimplifier {
   void store_block(const SurfaceBlock& block, BlockResult& out) const {
     out = BlockResult();
     std::vector<uint32_t> index(pos_.size(), kNone);
+    size_t live = 0, used = 0, moved = 0;
     for (size_t i = 0; i < tri_.size(); ++i)
-      if (tri_alive_[i])
+      if (tri_alive_[i]) {
+        ++live;
         for (uint32_t v : tri_[i]) index[v] = 0;
+      }
+    for (size_t v = 0; v < pos_.size(); ++v)
+      if (index[v] == 0) {
+        ++used;
+        moved += moved_[v];
+      }
+    out.positions.reserve(used);
+    out.keys.reserve(used);
+    out.quadrics.reserve(moved);
+    out.has_quadric.reserve(used);
+    out.debt6.reserve(used);
+    out.triangles.reserve(live);
     for (size_t v = 0; v < pos_.size(); ++v) {
       if (index[v] == kNone) continue;
       index[v] = uint32_t(out.positions.size());
       out.positions.push_back(pos_[v]);
       out.keys.push_back(block.keys[v]);
-      out.quadrics.push_back(quadric_[v]);
+      if (moved_[v]) out.quadrics.push_back(quadric_[v]);
       out.has_quadric.push_back(moved_[v]);
       out.debt6.push_back(debt_[v]);
     }
@@ -458,6 +500,9 @@ class RegionSimplifier {
  private:
   static constexpr uint8_t kUnknownAxis = 0xff;  // graph_axis_: 2 * axis + (sign < 0), or unknown
   static constexpr int kMaxCells = 32;           // grid cells per axis of a region
+  // verify()'s grid: about eight live triangles per cell (the walk of 10 000 capsules: verification
+  // 1.6 thread seconds with two, 1.3 with eight or sixteen).
+  static constexpr double kVerifyTrianglesPerCell = 8;
   struct Entry {
     float lo[3], hi[3];
     uint32_t tri, version;
@@ -612,12 +657,12 @@ class RegionSimplifier {
       if (tri_alive_[t]) insert(t);
   }
 
-  // The cells of the grids over the region's box (build_grid's, verify's): about two live
+  // The cells of the grids over the region's box (build_grid's, verify's): about `per_cell` live
   // triangles per cell of a surface through the box, so cells ~ live^(1/2) per axis.
-  void size_grid() {
+  void size_grid(double per_cell = 2.0) {
     size_t live = 0;
     for (uint8_t alive : tri_alive_) live += alive;
-    cells_ = int(std::clamp(std::sqrt(double(live) / 2.0), 4.0, double(kMaxCells)));
+    cells_ = int(std::clamp(std::sqrt(double(live) / per_cell), 4.0, double(kMaxCells)));
     const Vec3d size = box_.hi - box_.lo;
     for (int k = 0; k < 3; ++k) inv_cell_[k] = cells_ / size[k];
   }
@@ -1106,6 +1151,7 @@ class RegionSimplifier {
   enum class Placement { kBest, kAtKeep, kAtDrop };
   RegionBox box_;
   std::vector<uint32_t> global_vertex_;
+  std::vector<uint32_t> local_of_;  // per global vertex: its local number while a region loads, else kNone
   std::vector<std::array<uint32_t, 3>> tri_;
   std::vector<Vec3d> pos_;
   std::vector<Quadric> quadric_;
@@ -1232,9 +1278,9 @@ struct PassScope {
 // triangle belongs to every region whose open box its box meets, and to the region holding its
 // centroid (which is the one that writes it). The regions' triangles, in key order, replace
 // `triangles`, or, when `out` is given, are appended to it and `triangles` stays as it was.
-void simplify_pass(Vertices& vertices, std::vector<std::array<uint32_t, 3>>& triangles, const Lattice& lattice,
-                   const SimplifyOptions& options, SimplifyStats& stats, const PassScope& scope = {},
-                   std::vector<std::array<uint32_t, 3>>* out_triangles = nullptr) {
+template <class Triangles>
+void simplify_pass(Vertices& vertices, Triangles& triangles, const Lattice& lattice, const SimplifyOptions& options,
+                   SimplifyStats& stats, const PassScope& scope = {}, Triangles* out_triangles = nullptr) {
   const std::vector<Vec3d>& positions = vertices.positions;
   auto boundary = [&](int k, int64_t i) { return lattice.boundary(k, i); };
   auto index_of = [&](int k, double v) { return lattice.index_of(k, v); };
@@ -1316,15 +1362,21 @@ void simplify_pass(Vertices& vertices, std::vector<std::array<uint32_t, 3>>& tri
       lattice.unpack(members[region_start[r]].first, ri, rj, rk);
       const RegionBox box{{boundary(0, ri), boundary(1, rj), boundary(2, rk)},
                           {boundary(0, ri + 1), boundary(1, rj + 1), boundary(2, rk + 1)}};
-      simplify_region(simplifier, [&] { simplifier.load_global(box, triangles, ids, vertices); }, region_stats[r]);
+      simplify_region(simplifier, [&] { simplifier.load_global(box, triangles.data(), ids, vertices); }, region_stats[r]);
       simplifier.store_global(vertices, out[r], debt_changes[r]);
       progress.advance();
     }
   });
-  std::vector<std::array<uint32_t, 3>> replaced;
-  std::vector<std::array<uint32_t, 3>>& result = out_triangles ? *out_triangles : replaced;
+  Triangles replaced;
+  Triangles& result = out_triangles ? *out_triangles : replaced;
+  std::vector<size_t> at(regions + 1, result.size());
+  for (size_t r = 0; r < regions; ++r) at[r + 1] = at[r] + out[r].size();
+  result.resize(at[regions]);
+  tbb::parallel_for(size_t(0), regions, [&](size_t r) {
+    std::copy(out[r].begin(), out[r].end(), result.begin() + std::ptrdiff_t(at[r]));
+    std::vector<std::array<uint32_t, 3>>().swap(out[r]);
+  });
   for (size_t r = 0; r < regions; ++r) {
-    result.insert(result.end(), out[r].begin(), out[r].end());
     if (scope.apply_debt)
       for (const auto& [v, change] : debt_changes[r]) vertices.debt6[v] += change;
     add_region_stats(stats, region_stats[r]);
@@ -1334,7 +1386,8 @@ void simplify_pass(Vertices& vertices, std::vector<std::array<uint32_t, 3>>& tri
 }
 
 // The vertices the triangles use, renumbered in their order, and the triangles.
-TriMesh compact(const std::vector<Vec3d>& positions, const std::vector<std::array<uint32_t, 3>>& triangles) {
+template <class Triangles>
+TriMesh compact(const std::vector<Vec3d>& positions, const Triangles& triangles) {
   TriMesh out;
   std::vector<uint32_t> index(positions.size(), kNone);
   for (const auto& t : triangles)
@@ -1480,33 +1533,29 @@ TriMesh extract_simplified_surface(const Volume& volume, const SimplifyOptions& 
   for (size_t i = 0; i < blocks; ++i)
     for (size_t v = 0; v < results[i].positions.size(); ++v)
       if (results[i].keys[v] != kInteriorVertex) vertices.debt6[global[i][v]] += results[i].debt6[v];
-  std::vector<std::vector<std::array<uint32_t, 3>>> block_tris(blocks);
+  std::vector<size_t> first_triangle(blocks + 1, 0);
+  for (size_t i = 0; i < blocks; ++i) first_triangle[i + 1] = first_triangle[i] + results[i].triangles.size();
+  TriangleList triangles(first_triangle[blocks]);
   tbb::parallel_for(size_t(0), blocks, [&](size_t i) {
     BlockResult& r = results[i];
     const std::vector<uint32_t>& g = global[i];
+    size_t next_quadric = 0;
     for (size_t v = 0; v < r.positions.size(); ++v) {
       positions[g[v]] = r.positions[v];  // a shared vertex is the same float triple from every block
       if (r.keys[v] == kInteriorVertex) {
-        vertices.quadrics[g[v]] = r.quadrics[v];
+        if (r.has_quadric[v]) vertices.quadrics[g[v]] = r.quadrics[next_quadric];
         vertices.has_quadric[g[v]] = r.has_quadric[v];
         vertices.debt6[g[v]] = r.debt6[v];
       }
+      next_quadric += r.has_quadric[v];
     }
-    block_tris[i].reserve(r.triangles.size());
-    for (const auto& t : r.triangles) block_tris[i].push_back({g[t[0]], g[t[1]], g[t[2]]});
+    for (size_t t = 0; t < r.triangles.size(); ++t) {
+      const auto& tri = r.triangles[t];
+      triangles[first_triangle[i] + t] = {g[tri[0]], g[tri[1]], g[tri[2]]};
+    }
     r = BlockResult();
     std::vector<uint32_t>().swap(global[i]);
   });
-  std::vector<std::array<uint32_t, 3>> triangles;
-  {
-    size_t n = 0;
-    for (const auto& b : block_tris) n += b.size();
-    triangles.reserve(n);
-    for (auto& b : block_tris) {
-      triangles.insert(triangles.end(), b.begin(), b.end());
-      std::vector<std::array<uint32_t, 3>>().swap(b);
-    }
-  }
   // The blocks' results are copied out and freed: their pages go back before the pass takes more.
   release_free_memory();
   // Across the block faces: regions of the same size, shifted by half a block, so each holds a
@@ -1522,7 +1571,7 @@ TriMesh extract_simplified_surface(const Volume& volume, const SimplifyOptions& 
   }
   // The quadrics and debts are done with: freed before the compact copy is made (a fifth of the
   // surface's peak memory on the lacunar egg benchmark).
-  std::vector<Quadric>().swap(vertices.quadrics);
+  decltype(vertices.quadrics)().swap(vertices.quadrics);
   std::vector<uint8_t>().swap(vertices.has_quadric);
   std::vector<double>().swap(vertices.debt6);
   TriMesh out = compact(positions, triangles);
@@ -1586,10 +1635,13 @@ struct StreamedSurface::Impl {
       if (r.triangles.empty()) continue;
       const uint64_t bk = block_key(r.origin_voxels);
       std::vector<uint32_t> local(r.positions.size());
+      size_t next_quadric = 0;
       for (size_t v = 0; v < r.positions.size(); ++v) {
+        const size_t quadric = next_quadric;
+        next_quadric += r.has_quadric[v];
         if (r.keys[v] == kInteriorVertex) {
           const uint32_t w = local[v] = new_vertex(r.positions[v], {bk, v});
-          window.quadrics[w] = r.quadrics[v];
+          if (r.has_quadric[v]) window.quadrics[w] = r.quadrics[quadric];
           window.has_quadric[w] = r.has_quadric[v];
           window.debt6[w] = r.debt6[v];
         } else {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <iostream>
 #include <map>
 #include <set>
 
@@ -217,6 +218,57 @@ void expect_same_solid(const Surfaces& s, double deviation, double volume_fracti
   // Every cube's share of the loss, summed, is the whole surface's loss.
   EXPECT_NEAR(s.lost_mm3, s.plain_report.volume_mm3 - s.merged_report.volume_mm3, 1e-9 * s.plain_report.volume_mm3);
   EXPECT_LT(s.merged.triangles.size(), s.plain.triangles.size());
+}
+
+// On a flat patch the merge takes a candidate by an exact argument instead of running the sampled
+// deviation tests (solids/cube_surface.cpp): it must give what the sampled tests give, triangles and
+// volume shares, on planes and bent planes through single cubes, for any kept faces and deviations
+// from tight to loose; and on these it must be the argument that decides most merges.
+TEST(CubeSurface, FlatPatchesMergeAsTheSampledTestsDo) {
+  Random random(29);
+  uint64_t proven = 0, merged = 0, compared = 0;
+  for (int trial = 0; trial < 6000; ++trial) {
+    // f(x) = n . (x - p) + c |x - p|^2: a plane through p, bent by c (none for a third of them).
+    Vec3d n{2 * random.uniform() - 1, 2 * random.uniform() - 1, 2 * random.uniform() - 1};
+    if (!(norm(n) > 0.1)) continue;
+    n = n / norm(n);
+    const Vec3d p{0.2 + 0.6 * random.uniform(), 0.2 + 0.6 * random.uniform(), 0.2 + 0.6 * random.uniform()};
+    const double c = trial % 3 == 0 ? 0.0 : (random.uniform() - 0.5) * (trial % 3 == 1 ? 0.2 : 2.0);
+    float values[8];
+    for (int k = 0; k < 8; ++k) {
+      const Vec3d corner{double(k & 1), double((k >> 1) & 1), double((k >> 2) & 1)};
+      values[k] = float(dot(n, corner - p) + c * dot(corner - p, corner - p));
+      if (values[k] == 0) values[k] = 1e-3f;
+    }
+    const UnitCube cube = unit_cube(values);
+    if (cube.inside == 0 || cube.inside == 255) continue;
+    for (double deviation : {0.002, 0.01, 0.05, 0.3}) {
+      const uint8_t kept = trial % 4 == 0 ? 0 : uint8_t(random.next() & 0x3f);
+      cube_surface::MergeInput in = cube.input(kept, deviation);
+      uint64_t here = 0;
+      in.proven_candidates = &here;
+      cube_surface::MergeInput sampled_in = cube.input(kept, deviation);
+      sampled_in.sampled_tests_only = true;
+      std::vector<Tri8> fast, sampled;
+      cube_surface::VolumeShares fast_lost, sampled_lost;
+      const bool fast_merged = cube_surface::merged_triangles(in, fast, &fast_lost);
+      const bool sampled_merged = cube_surface::merged_triangles(sampled_in, sampled, &sampled_lost);
+      ++compared;
+      ASSERT_EQ(fast_merged, sampled_merged) << "trial " << trial << ", deviation " << deviation;
+      ASSERT_EQ(fast, sampled) << "trial " << trial << ", deviation " << deviation;
+      if (!fast_merged) continue;
+      ++merged;
+      proven += here;
+      ASSERT_EQ(fast_lost.count, sampled_lost.count);
+      for (int i = 0; i < fast_lost.count; ++i) {
+        EXPECT_EQ(fast_lost.slots[i], sampled_lost.slots[i]);
+        EXPECT_EQ(fast_lost.volume6[i], sampled_lost.volume6[i]);
+      }
+    }
+  }
+  std::cout << compared << " compared, " << merged << " merged, " << proven << " proven\n";
+  EXPECT_GT(merged, compared / 2);
+  EXPECT_GT(proven, merged / 2);
 }
 
 TEST(CubeSurface, SphereMergesToAThirdOfItsPieces) {
