@@ -412,7 +412,6 @@ bool merged_triangles(const MergeInput& in, std::vector<std::array<uint8_t, 3>>&
         for (int u = 0; u < own_count && proven; ++u)
           if (!(dot(facing, near_own[u].normal_vector()) > 0)) proven = false;
       }
-      if (proven && in.proven_candidates) ++*in.proven_candidates;
       // The left-out crossings lie within the deviation of the new triangles.
       for (int r = 0; r < removed_count && ok && !proven; ++r) {
         bool near = false;
@@ -457,6 +456,7 @@ bool merged_triangles(const MergeInput& in, std::vector<std::array<uint8_t, 3>>&
         result_new[result_count++] = 1;
       }
       found = true;
+      if (proven && in.proven_candidates) ++*in.proven_candidates;
       if (lost) {
         // Pieces minus merged triangles plus the face triangles (a, b, d) of the merged sides
         // a -> b that replace a -> d -> b: that chain has no boundary, so its volume is the loss.

@@ -117,7 +117,7 @@ struct MergeInput {
   uint8_t kept_faces = 0;            // faces whose diagonal crossing stays (bit per face)
   double max_deviation_mm = 0;       // how far the merged patches may stray from the pieces
   // For tests: decide every candidate by the sampled tests (no flat patch's proof), and count
-  // the candidates the proof took.
+  // the patches whose triangulation was taken on the proof.
   bool sampled_tests_only = false;
   uint64_t* proven_candidates = nullptr;
 };

@@ -304,17 +304,32 @@ class RegionSimplifier {
                    const std::vector<uint32_t>& tri_ids, const Vertices& vertices) {
     box_ = box;
     const size_t nt = tri_ids.size();
-    // Each global vertex once (marked in local_of_, which is all kNone between loads), in the
-    // order the region numbers them: by index, or as the whole surface numbers them, so the region
-    // does what it does there.
-    if (local_of_.size() < vertices.positions.size()) local_of_.assign(vertices.positions.size(), kNone);
+    // Each global vertex once, numbered in the order the region numbers them: by index, or as the
+    // whole surface numbers them, so the region does what it does there. An open-addressing table
+    // of the region's own size (global id -> slot) finds them; the corners hold their slots until
+    // the numbers are known.
+    size_t capacity = 16;
+    while (capacity < 6 * nt) capacity *= 2;
+    vertex_keys_.assign(capacity, kNone);
+    vertex_numbers_.resize(capacity);
+    const size_t mask = capacity - 1;
+    auto slot_of = [&](uint32_t g) {
+      size_t i = size_t((uint64_t(g) * 0x9e3779b97f4a7c15ull) >> 32) & mask;
+      while (vertex_keys_[i] != kNone && vertex_keys_[i] != g) i = (i + 1) & mask;
+      return i;
+    };
     global_vertex_.clear();
-    for (uint32_t t : tri_ids)
-      for (uint32_t v : global_tris[t])
-        if (local_of_[v] == kNone) {
-          local_of_[v] = 0;
-          global_vertex_.push_back(v);
+    tri_.resize(nt);
+    for (size_t i = 0; i < nt; ++i)
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t g = global_tris[tri_ids[i]][size_t(k)];
+        const size_t slot = slot_of(g);
+        if (vertex_keys_[slot] == kNone) {
+          vertex_keys_[slot] = g;
+          global_vertex_.push_back(g);
         }
+        tri_[i][size_t(k)] = uint32_t(slot);
+      }
     if (vertices.order.empty()) {
       std::sort(global_vertex_.begin(), global_vertex_.end());
     } else {
@@ -322,11 +337,9 @@ class RegionSimplifier {
       std::sort(global_vertex_.begin(), global_vertex_.end(), [&](uint32_t a, uint32_t b) { return order[a] < order[b]; });
     }
     const size_t nv = global_vertex_.size();
-    for (size_t v = 0; v < nv; ++v) local_of_[global_vertex_[v]] = uint32_t(v);
-    tri_.resize(nt);
-    for (size_t i = 0; i < nt; ++i)
-      for (int k = 0; k < 3; ++k) tri_[i][size_t(k)] = local_of_[global_tris[tri_ids[i]][size_t(k)]];
-    for (uint32_t g : global_vertex_) local_of_[g] = kNone;
+    for (size_t v = 0; v < nv; ++v) vertex_numbers_[slot_of(global_vertex_[v])] = uint32_t(v);
+    for (auto& t : tri_)
+      for (uint32_t& corner : t) corner = vertex_numbers_[corner];
     pos_.resize(nv);
     quadric_.assign(nv, Quadric());
     own_quadric_.assign(nv, 0);
@@ -1151,7 +1164,7 @@ class RegionSimplifier {
   enum class Placement { kBest, kAtKeep, kAtDrop };
   RegionBox box_;
   std::vector<uint32_t> global_vertex_;
-  std::vector<uint32_t> local_of_;  // per global vertex: its local number while a region loads, else kNone
+  std::vector<uint32_t> vertex_keys_, vertex_numbers_;  // load_global's table: global id, local number
   std::vector<std::array<uint32_t, 3>> tri_;
   std::vector<Vec3d> pos_;
   std::vector<Quadric> quadric_;

@@ -223,7 +223,8 @@ void expect_same_solid(const Surfaces& s, double deviation, double volume_fracti
 // On a flat patch the merge takes a candidate by an exact argument instead of running the sampled
 // deviation tests (solids/cube_surface.cpp): it must give what the sampled tests give, triangles and
 // volume shares, on planes and bent planes through single cubes, for any kept faces and deviations
-// from tight to loose; and on these it must be the argument that decides most merges.
+// from tight to loose; and on these the argument must take the triangulations of more patches than
+// half the merged cubes.
 TEST(CubeSurface, FlatPatchesMergeAsTheSampledTestsDo) {
   Random random(29);
   uint64_t proven = 0, merged = 0, compared = 0;
