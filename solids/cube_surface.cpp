@@ -260,10 +260,16 @@ bool merged_triangles(const MergeInput& in, std::vector<std::array<uint8_t, 3>>&
     uint8_t loop[kMaxSlotsInLoop], faces[kMaxSlotsInLoop], at[kMaxSlotsInLoop];
     uint8_t removed[kMaxSlotsInLoop + 4];
     int k = 0, removed_count = 0;
+    double reach = 0;  // the farthest a left-out crossing lies from the segment between its neighbours
     for (int i = 0; i < patch.loop_length; ++i) {
       const int s = patch.loop[i];
       if (is_face_diagonal(s) && !((in.kept_faces >> face_of_diagonal(s)) & 1)) {
         removed[removed_count++] = uint8_t(s);
+        const Vec3d& a = pos[patch.loop[(i + patch.loop_length - 1) % patch.loop_length]];
+        const Vec3d ab = pos[patch.loop[(i + 1) % patch.loop_length]] - a, as = pos[s] - a;
+        const double len2 = dot(ab, ab);
+        const double t = len2 > 0 ? std::clamp(dot(as, ab) / len2, 0.0, 1.0) : 0.0;
+        reach = std::max(reach, norm(as - ab * t));
         continue;
       }
       at[k] = uint8_t(i);
@@ -355,16 +361,6 @@ bool merged_triangles(const MergeInput& in, std::vector<std::array<uint8_t, 3>>&
                          : (std::fabs(normal.y) >= std::fabs(normal.z) ? 1 : 2);
       const int fi = (fk + 1) % 3, fj = (fk + 2) % 3, fs = normal[fk] > 0 ? 1 : -1;
       bool flat = std::fabs(normal[fk]) > 0;
-      double h = 0;  // the largest H
-      for (int i = 0; i < patch.loop_length; ++i) {
-        const int d = patch.loop[i];
-        if (!is_face_diagonal(d) || ((in.kept_faces >> face_of_diagonal(d)) & 1)) continue;
-        const Vec3d& a = pos[patch.loop[(i + patch.loop_length - 1) % patch.loop_length]];
-        const Vec3d ab = pos[patch.loop[(i + 1) % patch.loop_length]] - a, ad = pos[d] - a;
-        const double len2 = dot(ab, ab);
-        const double t = len2 > 0 ? std::clamp(dot(ad, ab) / len2, 0.0, 1.0) : 0.0;
-        h = std::max(h, norm(ad - ab * t));
-      }
       for (int t = 0; t < own_count && flat; ++t) {
         const Vec3d &a = pos[own[t][0]], &b = pos[own[t][1]], &d = pos[own[t][2]];
         if (exact::orient2d(a[fi], a[fj], b[fi], b[fj], d[fi], d[fj]) != fs) flat = false;
@@ -383,7 +379,7 @@ bool merged_triangles(const MergeInput& in, std::vector<std::array<uint8_t, 3>>&
           lowest = std::min(lowest, height);
           highest = std::max(highest, height);
         }
-        flat = (highest - lowest) + h <= 0.999 * dev;
+        flat = (highest - lowest) + reach <= 0.999 * dev;  // W + H
       }
       if (flat && !in.sampled_tests_only) {
         flat_axis = fk;

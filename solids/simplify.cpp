@@ -283,6 +283,33 @@ using TriangleList = std::vector<std::array<uint32_t, 3>, UnsetAllocator<std::ar
 // that share none with exact predicates. A region whose result fails verify() is simplified
 // again, guarded, from its input, so nothing untested leaves it either way; the second way is several times faster and
 // almost never has to redo a region.
+// An open-addressing table (linear probing) from 64-bit keys to 32-bit values, sized to be at most
+// half full with the entries it is reset for; slot() finds a key's slot, or the empty one where it
+// would go.
+class SlotTable {
+ public:
+  static constexpr uint64_t kEmpty = UINT64_MAX;
+  void reset(size_t entries) {
+    size_t capacity = 16;
+    while (capacity < 2 * entries) capacity *= 2;
+    keys_.assign(capacity, kEmpty);
+    values_.resize(capacity);
+    mask_ = capacity - 1;
+  }
+  size_t slot(uint64_t key) const {
+    size_t i = size_t((key * 0x9e3779b97f4a7c15ull) >> 32) & mask_;
+    while (keys_[i] != kEmpty && keys_[i] != key) i = (i + 1) & mask_;
+    return i;
+  }
+  uint64_t& key(size_t slot) { return keys_[slot]; }
+  uint32_t& value(size_t slot) { return values_[slot]; }
+
+ private:
+  std::vector<uint64_t> keys_;
+  std::vector<uint32_t> values_;
+  size_t mask_ = 0;
+};
+
 class RegionSimplifier {
  public:
   explicit RegionSimplifier(const SimplifyOptions& options) {
@@ -305,27 +332,18 @@ class RegionSimplifier {
     box_ = box;
     const size_t nt = tri_ids.size();
     // Each global vertex once, numbered in the order the region numbers them: by index, or as the
-    // whole surface numbers them, so the region does what it does there. An open-addressing table
-    // of the region's own size (global id -> slot) finds them; the corners hold their slots until
-    // the numbers are known.
-    size_t capacity = 16;
-    while (capacity < 6 * nt) capacity *= 2;
-    vertex_keys_.assign(capacity, kNone);
-    vertex_numbers_.resize(capacity);
-    const size_t mask = capacity - 1;
-    auto slot_of = [&](uint32_t g) {
-      size_t i = size_t((uint64_t(g) * 0x9e3779b97f4a7c15ull) >> 32) & mask;
-      while (vertex_keys_[i] != kNone && vertex_keys_[i] != g) i = (i + 1) & mask;
-      return i;
-    };
+    // whole surface numbers them, so the region does what it does there. A table of the region's
+    // own size (global id -> slot) finds them; the corners hold their slots until the numbers are
+    // known.
+    table_.reset(3 * nt);
     global_vertex_.clear();
     tri_.resize(nt);
     for (size_t i = 0; i < nt; ++i)
       for (int k = 0; k < 3; ++k) {
         const uint32_t g = global_tris[tri_ids[i]][size_t(k)];
-        const size_t slot = slot_of(g);
-        if (vertex_keys_[slot] == kNone) {
-          vertex_keys_[slot] = g;
+        const size_t slot = table_.slot(g);
+        if (table_.key(slot) == SlotTable::kEmpty) {
+          table_.key(slot) = g;
           global_vertex_.push_back(g);
         }
         tri_[i][size_t(k)] = uint32_t(slot);
@@ -337,9 +355,9 @@ class RegionSimplifier {
       std::sort(global_vertex_.begin(), global_vertex_.end(), [&](uint32_t a, uint32_t b) { return order[a] < order[b]; });
     }
     const size_t nv = global_vertex_.size();
-    for (size_t v = 0; v < nv; ++v) vertex_numbers_[slot_of(global_vertex_[v])] = uint32_t(v);
+    for (size_t v = 0; v < nv; ++v) table_.value(table_.slot(global_vertex_[v])) = uint32_t(v);
     for (auto& t : tri_)
-      for (uint32_t& corner : t) corner = vertex_numbers_[corner];
+      for (uint32_t& corner : t) corner = table_.value(corner);
     pos_.resize(nv);
     quadric_.assign(nv, Quadric());
     own_quadric_.assign(nv, 0);
@@ -567,36 +585,27 @@ class RegionSimplifier {
   void pair_half_edges() {
     const size_t nt = tri_.size();
     opp_.assign(4 * nt, kNone);
-    size_t capacity = 16;
-    while (capacity < 6 * nt) capacity *= 2;
-    table_keys_.assign(capacity, UINT64_MAX);
-    table_values_.resize(capacity);
-    const size_t mask = capacity - 1;
-    auto slot_of = [&](uint64_t key) {
-      size_t i = size_t((key * 0x9e3779b97f4a7c15ull) >> 20) & mask;
-      while (table_keys_[i] != UINT64_MAX && table_keys_[i] != key) i = (i + 1) & mask;
-      return i;
-    };
+    table_.reset(3 * nt);
     for (uint32_t t = 0; t < nt; ++t)
       for (uint32_t k = 0; k < 3; ++k) {
         const uint32_t h = 4 * t + k, a = from(h), b = to(h);
         if (a == b) continue;
         const uint64_t key = (uint64_t(a) << 32) | b;
-        const size_t i = slot_of(key);
-        if (table_keys_[i] == key) {
-          table_values_[i] = kNone;  // two half-edges a -> b: the edge is not manifold
+        const size_t i = table_.slot(key);
+        if (table_.key(i) == key) {
+          table_.value(i) = kNone;  // two half-edges a -> b: the edge is not manifold
         } else {
-          table_keys_[i] = key;
-          table_values_[i] = h;
+          table_.key(i) = key;
+          table_.value(i) = h;
         }
       }
     for (uint32_t t = 0; t < nt; ++t)
       for (uint32_t k = 0; k < 3; ++k) {
         const uint32_t h = 4 * t + k, a = from(h), b = to(h);
         if (a == b) continue;
-        const size_t own = slot_of((uint64_t(a) << 32) | b), back = slot_of((uint64_t(b) << 32) | a);
-        if (table_values_[own] == kNone || table_keys_[back] == UINT64_MAX || table_values_[back] == kNone) continue;
-        opp_[h] = table_values_[back];
+        const size_t own = table_.slot((uint64_t(a) << 32) | b), back = table_.slot((uint64_t(b) << 32) | a);
+        if (table_.value(own) == kNone || table_.key(back) == SlotTable::kEmpty || table_.value(back) == kNone) continue;
+        opp_[h] = table_.value(back);
       }
   }
 
@@ -1164,7 +1173,6 @@ class RegionSimplifier {
   enum class Placement { kBest, kAtKeep, kAtDrop };
   RegionBox box_;
   std::vector<uint32_t> global_vertex_;
-  std::vector<uint32_t> vertex_keys_, vertex_numbers_;  // load_global's table: global id, local number
   std::vector<std::array<uint32_t, 3>> tri_;
   std::vector<Vec3d> pos_;
   std::vector<Quadric> quadric_;
@@ -1174,8 +1182,7 @@ class RegionSimplifier {
   std::vector<Entry> verify_boxes_;
   std::vector<uint32_t> verify_start_, verify_cursor_, verify_entries_;
   std::vector<uint32_t> version_, degree_, corner_, opp_;
-  std::vector<uint64_t> table_keys_;
-  std::vector<uint32_t> table_values_;
+  SlotTable table_;  // load_global's (global id -> local number) and pair_half_edges' (a -> b half-edge)
   CollapseQueue queue_;
   double inv_cell_[3] = {1, 1, 1};
   int cells_ = kMaxCells;
