@@ -169,12 +169,13 @@ struct NearTriangle {
     length = norm(n);
   }
   Vec3d normal_vector() const { return {normal[0], normal[1], normal[2]}; }
-  bool near(const Vec3d& q, double d) const {
+  // d2: squared_limit(d), so the squared distance decides as the distance would.
+  bool near(const Vec3d& q, double d, double d2) const {
     if (q.x < lo[0] || q.x > hi[0] || q.y < lo[1] || q.y > hi[1] || q.z < lo[2] || q.z > hi[2]) return false;
     const Vec3d& pa = pos[a];
     if (std::fabs(normal[0] * (q.x - pa.x) + normal[1] * (q.y - pa.y) + normal[2] * (q.z - pa.z)) > d * length)
       return false;  // even its plane is farther
-    return point_triangle_distance(q, pa, pos[b], pos[c]) <= d;
+    return point_triangle_distance2(q, pa, pos[b], pos[c]) <= d2;
   }
 };
 
@@ -221,6 +222,10 @@ bool merged_triangles(const MergeInput& in, std::vector<std::array<uint8_t, 3>>&
   if (c.keeps_pieces) return false;
   const Vec3d* pos = in.positions;
   const double dev = in.max_deviation_mm;
+  // Its squared limit, worked out once per thread and deviation (every cube of a surface shares it).
+  static thread_local double limit_of = -1, limit2 = 0;
+  if (dev != limit_of) limit2 = squared_limit(dev), limit_of = dev;
+  const double dev2 = limit2;
 
   // The faces each crossing lies on, from its coordinates: they must be the faces of its edge,
   // or float32 rounding moved it onto a plane and the face rules would not hold.
@@ -411,7 +416,7 @@ bool merged_triangles(const MergeInput& in, std::vector<std::array<uint8_t, 3>>&
       // The left-out crossings lie within the deviation of the new triangles.
       for (int r = 0; r < removed_count && ok && !proven; ++r) {
         bool near = false;
-        for (int t = 0; t < m && !near; ++t) near = near_new[t].near(pos[removed[r]], dev);
+        for (int t = 0; t < m && !near; ++t) near = near_new[t].near(pos[removed[r]], dev, dev2);
         ok = near;
       }
       if (!ok) continue;
@@ -419,7 +424,7 @@ bool merged_triangles(const MergeInput& in, std::vector<std::array<uint8_t, 3>>&
       // centre lies near a piece that faces its way.
       auto near_pieces = [&](const Vec3d& q, const Vec3d* facing) {
         for (int t = 0; t < own_count; ++t)
-          if ((!facing || dot(*facing, near_own[t].normal_vector()) > 0) && near_own[t].near(q, dev)) return true;
+          if ((!facing || dot(*facing, near_own[t].normal_vector()) > 0) && near_own[t].near(q, dev, dev2)) return true;
         return false;
       };
       for (int t = 0; t < m && ok && !proven; ++t) {

@@ -98,35 +98,14 @@ class TriangleGrid {
 }  // namespace
 
 double point_triangle_distance(const Vec3d& p, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
-  // Ericson, Real-Time Collision Detection, 5.1.5: the closest point by Voronoi regions.
-  const Vec3d ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
-  if (d1 <= 0 && d2 <= 0) return norm(p - a);
-  const Vec3d bp = p - b;
-  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
-  if (d3 >= 0 && d4 <= d3) return norm(p - b);
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return norm(p - (a + ab * (d1 / (d1 - d3))));
-  const Vec3d cp = p - c;
-  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
-  if (d6 >= 0 && d5 <= d6) return norm(p - c);
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return norm(p - (a + ac * (d2 / (d2 - d6))));
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
-    return norm(p - (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)))));
-  const double denominator = va + vb + vc;
-  if (!(denominator > 0)) {  // degenerate: the nearest of its edges
-    auto segment = [&](const Vec3d& u, const Vec3d& v) {
-      const Vec3d d = v - u;
-      const double len2 = dot(d, d);
-      const double t = len2 > 0 ? std::clamp(dot(p - u, d) / len2, 0.0, 1.0) : 0.0;
-      return norm(p - (u + d * t));
-    };
-    return std::min({segment(a, b), segment(b, c), segment(c, a)});
-  }
-  const double v = vb / denominator, w = vc / denominator;
-  return norm(p - (a + ab * v + ac * w));
+  return std::sqrt(point_triangle_distance2(p, a, b, c));
+}
+
+double squared_limit(double d) {
+  double s = d * d;
+  while (s > 0 && std::sqrt(s) > d) s = std::nextafter(s, 0.0);
+  while (std::sqrt(std::nextafter(s, HUGE_VAL)) <= d) s = std::nextafter(s, HUGE_VAL);
+  return s;
 }
 
 double sampled_hausdorff_mm(const TriMesh& from, const TriMesh& to, double fine_area_mm2, Vec3d* where) {

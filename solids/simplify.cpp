@@ -320,6 +320,7 @@ class RegionSimplifier {
     // vertices add a little: at three quarters of the deviation the measured one-sided Hausdorff
     // distances stay within it (see the simplify tests and the capsule benchmark).
     max_deviation_ = kDeviationMargin * options.max_deviation_mm;
+    deviation_limit2_ = squared_limit(max_deviation_);
     tolerance2_ = max_deviation_ * max_deviation_;
     quadric_tolerance2_ = tolerance2_;
     cos_normal_ = std::cos(options.max_normal_change_deg * kPi / 180.0);
@@ -622,8 +623,9 @@ class RegionSimplifier {
       if (box_.in_closed(pos_[t[0]]) && box_.in_closed(pos_[t[1]]) && box_.in_closed(pos_[t[2]])) continue;
       locked_[t[0]] = locked_[t[1]] = locked_[t[2]] = 1;
     }
+    open_fan_.assign(nv, 0);
     for (size_t v = 0; v < nv; ++v)
-      if (!locked_[v] && !walk_fan(uint32_t(v), nullptr, nullptr)) locked_[v] = 1;
+      if (!walk_fan(uint32_t(v), nullptr, nullptr)) open_fan_[v] = locked_[v] = 1;
   }
 
   // Walks the fan of v (corners at v, and the vertex each leads to); false when it is not one
@@ -754,6 +756,8 @@ class RegionSimplifier {
     uint32_t keep = x, drop = y;
     if (locked_[x] == 0 && locked_[y] == 0 && y < x) std::swap(keep, drop);  // deterministic choice
     if (locked_[y]) std::swap(keep, drop);
+    // A collapse into a vertex whose fan is not closed (on the region's border) is never taken, and
+    // its fan stays open: collapses neither remove a border edge nor pair one.
     const Quadric q = quadric_[keep] + quadric_[drop];
     const double error = q.error(first_target(keep, drop, q));
     if (error > quadric_tolerance2_) return;
@@ -816,7 +820,7 @@ class RegionSimplifier {
     const double d = max_deviation_;
     for (int k = 0; k < 3; ++k)
       if (p[k] < std::min({a[k], b[k], c[k]}) - d || p[k] > std::max({a[k], b[k], c[k]}) + d) return false;
-    return point_triangle_distance(p, a, b, c) <= d;
+    return point_triangle_distance2(p, a, b, c) <= deviation_limit2_;
   }
 
   bool collapse(uint32_t keep, uint32_t drop) {
@@ -1168,6 +1172,7 @@ class RegionSimplifier {
   }
 
   double tolerance2_ = 0, quadric_tolerance2_ = 0, max_deviation_ = 0, cos_normal_ = 0;
+  double deviation_limit2_ = 0;  // squared_limit(max_deviation_): squared distances decide as distances
   bool guarded_ = false;
   // Where a collapse puts a free vertex: the best position (see collapse), or where keep or drop is.
   enum class Placement { kBest, kAtKeep, kAtDrop };
@@ -1178,7 +1183,7 @@ class RegionSimplifier {
   std::vector<Quadric> quadric_;
   std::vector<double> debt_, debt_start_;
   std::vector<double> quality2_, changed_quality2_;  // quality2 of every triangle, and of the changed ones as they would be
-  std::vector<uint8_t> own_quadric_, tri_alive_, tri_changed_, vertex_alive_, locked_, graph_axis_;
+  std::vector<uint8_t> own_quadric_, tri_alive_, tri_changed_, vertex_alive_, locked_, open_fan_, graph_axis_;
   std::vector<Entry> verify_boxes_;
   std::vector<uint32_t> verify_start_, verify_cursor_, verify_entries_;
   std::vector<uint32_t> version_, degree_, corner_, opp_;

@@ -546,6 +546,58 @@ TEST(Simplify, AnyClosedMeshAndItsBoundaryKept) {
 }
 
 
+// The closest point by Voronoi regions, against the distances each region has in closed form: the
+// right triangle (0,0,0), (1,0,0), (0,1,0) seen from above its inside, past each corner and each
+// edge, and a triangle folded flat onto a segment (nearest of its edges).
+TEST(Simplify, PointTriangleDistanceHasItsClosedForms) {
+  const Vec3d a{0, 0, 0}, b{1, 0, 0}, c{0, 1, 0};
+  struct Case {
+    Vec3d p;
+    double distance;
+  };
+  const Case cases[] = {
+      {{0.25, 0.25, 0.5}, 0.5},                     // above the inside: the height
+      {{-1, -1, 0}, std::sqrt(2.0)},                // past a
+      {{3, -1, 2}, 3},                              // past b: (2, -1, 2)
+      {{-0.5, 2, 0}, std::sqrt(1.25)},              // past c: (-0.5, 1, 0)
+      {{0.5, -2, 0}, 2},                            // beside ab
+      {{-3, 0.5, 4}, 5},                            // beside ca: (3, 0, 4)
+      {{1, 1, 0}, std::sqrt(0.5)},                  // beside bc: the line x + y = 1
+      {{0.75, 0.75, 1}, std::sqrt(0.125 + 1)},      // above beside bc
+  };
+  for (const Case& k : cases) {
+    const double d2 = point_triangle_distance2(k.p, a, b, c);
+    EXPECT_NEAR(std::sqrt(d2), k.distance, 1e-15) << k.p.x << " " << k.p.y << " " << k.p.z;
+    EXPECT_EQ(point_triangle_distance(k.p, a, b, c), std::sqrt(d2));
+    EXPECT_NEAR(point_triangle_distance2(k.p, b, c, a), d2, 1e-15) << "the corners' order does not matter";
+  }
+  // Degenerate: a, b and the midpoint of ab; the nearest point of the segment.
+  EXPECT_NEAR(point_triangle_distance({0.5, 2, 0}, a, b, {0.5, 0, 0}), 2, 1e-15);
+  EXPECT_NEAR(point_triangle_distance({3, 0, 4}, a, b, {0.5, 0, 0}), std::sqrt(4.0 + 16), 1e-15);
+}
+
+// squared_limit(d) is the largest double whose rounded root is at most d, so comparing a squared
+// distance with it decides as comparing the distance with d (the simplifier relies on this to give
+// the same surface either way).
+TEST(Simplify, SquaredLimitDecidesAsTheDistanceWould) {
+  uint64_t state = 12345;
+  auto next = [&] {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return double(state >> 11) / double(uint64_t(1) << 53);
+  };
+  for (int i = 0; i < 2000; ++i) {
+    const double d = i == 0 ? 0.0125 : std::ldexp(0.5 + next(), int(next() * 40) - 30);
+    const double s = squared_limit(d);
+    ASSERT_LE(std::sqrt(s), d) << d;
+    ASSERT_GT(std::sqrt(std::nextafter(s, HUGE_VAL)), d) << d;
+    // Squares near d * d, a few ulps either way, decide alike.
+    double x = d * d;
+    for (int k = 0; k < 8; ++k) x = std::nextafter(x, 0.0);
+    for (int k = 0; k < 16; ++k, x = std::nextafter(x, HUGE_VAL)) ASSERT_EQ(std::sqrt(x) <= d, x <= s) << d << " " << x;
+  }
+  EXPECT_EQ(squared_limit(0), 0.0);
+}
+
 TEST(Simplify, RefusesBadOptions) {
   SimplifyOptions options;
   options.max_deviation_mm = 0;
