@@ -758,6 +758,7 @@ class RegionSimplifier {
     if (locked_[y]) std::swap(keep, drop);
     // A collapse into a vertex whose fan is not closed (on the region's border) is never taken, and
     // its fan stays open: collapses neither remove a border edge nor pair one.
+    if (open_fan_[keep]) return;
     const Quadric q = quadric_[keep] + quadric_[drop];
     const double error = q.error(first_target(keep, drop, q));
     if (error > quadric_tolerance2_) return;
