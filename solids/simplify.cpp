@@ -274,15 +274,6 @@ struct Vertices {
 // A whole surface's triangles: resized unset, then filled in parallel.
 using TriangleList = std::vector<std::array<uint32_t, 3>, UnsetAllocator<std::array<uint32_t, 3>>>;
 
-// One region's piece of the mesh and the collapses in it. Everything is local: vertices and
-// triangles are renumbered, and only the region's own unlocked vertices are written back.
-//
-// Two ways to guard: `guarded` tests every collapse against every triangle near it (a grid of
-// the region, updated as triangles change); otherwise a collapse is tested against the triangles
-// that share its vertices, and verify() then tests the pairs of nearby triangles of the result
-// that share none with exact predicates. A region whose result fails verify() is simplified
-// again, guarded, from its input, so nothing untested leaves it either way; the second way is several times faster and
-// almost never has to redo a region.
 // An open-addressing table (linear probing) from 64-bit keys to 32-bit values, sized to be at most
 // half full with the entries it is reset for; slot() finds a key's slot, or the empty one where it
 // would go.
@@ -310,6 +301,15 @@ class SlotTable {
   size_t mask_ = 0;
 };
 
+// One region's piece of the mesh and the collapses in it. Everything is local: vertices and
+// triangles are renumbered, and only the region's own unlocked vertices are written back.
+//
+// Two ways to guard: `guarded` tests every collapse against every triangle near it (a grid of
+// the region, updated as triangles change); otherwise a collapse is tested against the triangles
+// that share its vertices, and verify() then tests the pairs of nearby triangles of the result
+// that share none with exact predicates. A region whose result fails verify() is simplified
+// again, guarded, from its input, so nothing untested leaves it either way; the second way is several times faster and
+// almost never has to redo a region.
 class RegionSimplifier {
  public:
   explicit RegionSimplifier(const SimplifyOptions& options) {
