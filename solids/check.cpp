@@ -143,9 +143,7 @@ bool fan_is_graph(const TriMesh& mesh, const EdgeTopology& edges, uint32_t start
     if (c == start_corner) break;
     if (c == kNoHalfEdge || steps > 4096) return false;
   }
-  const int k = std::fabs(normal.x) >= std::fabs(normal.y) && std::fabs(normal.x) >= std::fabs(normal.z)
-                    ? 0
-                    : (std::fabs(normal.y) >= std::fabs(normal.z) ? 1 : 2);
+  const int k = dominant_axis(normal);
   const int i = (k + 1) % 3, j = (k + 2) % 3;  // (i, j, k) right-handed
   const int sign = normal[k] > 0 ? 1 : -1;
   int crossings = 0;

@@ -270,11 +270,8 @@ bool merged_triangles(const MergeInput& in, std::vector<std::array<uint8_t, 3>>&
       const int s = patch.loop[i];
       if (is_face_diagonal(s) && !((in.kept_faces >> face_of_diagonal(s)) & 1)) {
         removed[removed_count++] = uint8_t(s);
-        const Vec3d& a = pos[patch.loop[(i + patch.loop_length - 1) % patch.loop_length]];
-        const Vec3d ab = pos[patch.loop[(i + 1) % patch.loop_length]] - a, as = pos[s] - a;
-        const double len2 = dot(ab, ab);
-        const double t = len2 > 0 ? std::clamp(dot(as, ab) / len2, 0.0, 1.0) : 0.0;
-        reach = std::max(reach, norm(as - ab * t));
+        reach = std::max(reach, std::sqrt(point_segment_distance2(pos[s], pos[patch.loop[(i + patch.loop_length - 1) % patch.loop_length]],
+                                                                  pos[patch.loop[(i + 1) % patch.loop_length]])));
         continue;
       }
       at[k] = uint8_t(i);
@@ -361,9 +358,7 @@ bool merged_triangles(const MergeInput& in, std::vector<std::array<uint8_t, 3>>&
     {
       Vec3d normal;
       for (int t = 0; t < own_count; ++t) normal += near_own[t].normal_vector();
-      const int fk = std::fabs(normal.x) >= std::fabs(normal.y) && std::fabs(normal.x) >= std::fabs(normal.z)
-                         ? 0
-                         : (std::fabs(normal.y) >= std::fabs(normal.z) ? 1 : 2);
+      const int fk = dominant_axis(normal);
       const int fi = (fk + 1) % 3, fj = (fk + 2) % 3, fs = normal[fk] > 0 ? 1 : -1;
       bool flat = std::fabs(normal[fk]) > 0;
       for (int t = 0; t < own_count && flat; ++t) {

@@ -38,15 +38,8 @@ inline double point_triangle_distance2(const Vec3d& p, const Vec3d& a, const Vec
   if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
     return norm2(p - (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)))));
   const double denominator = va + vb + vc;
-  if (!(denominator > 0)) {  // degenerate: the nearest of its edges
-    auto segment = [&](const Vec3d& u, const Vec3d& v) {
-      const Vec3d d = v - u;
-      const double len2 = dot(d, d);
-      const double t = len2 > 0 ? std::clamp(dot(p - u, d) / len2, 0.0, 1.0) : 0.0;
-      return norm2(p - (u + d * t));
-    };
-    return std::min({segment(a, b), segment(b, c), segment(c, a)});
-  }
+  if (!(denominator > 0))  // degenerate: the nearest of its edges
+    return std::min({point_segment_distance2(p, a, b), point_segment_distance2(p, b, c), point_segment_distance2(p, c, a)});
   const double v = vb / denominator, w = vc / denominator;
   return norm2(p - (a + ab * v + ac * w));
 }

@@ -795,9 +795,7 @@ class RegionSimplifier {
       const Vec3d a = position(rename(to(c))), b = position(rename(from(prev_he(c))));
       normal += cross(a - p, b - p);
     }
-    const int k = std::fabs(normal.x) >= std::fabs(normal.y) && std::fabs(normal.x) >= std::fabs(normal.z)
-                      ? 0
-                      : (std::fabs(normal.y) >= std::fabs(normal.z) ? 1 : 2);
+    const int k = dominant_axis(normal);
     const int i = (k + 1) % 3, j = (k + 2) % 3;
     const int sign = normal[k] > 0 ? 1 : -1;
     int crossings = 0;

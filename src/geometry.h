@@ -2,6 +2,7 @@
 // consume them. No library types appear here; all lengths are millimetres.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -50,6 +51,20 @@ inline Vec3d round_to_output(const Vec3d& v) { return {round_to_output(v.x), rou
 inline bool is_finite(const Vec3d& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
+// The axis along which n is largest in magnitude (ties to the lower axis): dropping it projects a
+// plane with normal n onto the coordinate plane it is least foreshortened on.
+inline int dominant_axis(const Vec3d& n) {
+  const double x = std::fabs(n.x), y = std::fabs(n.y), z = std::fabs(n.z);
+  return x >= y && x >= z ? 0 : (y >= z ? 1 : 2);
+}
+// The squared distance from p to the closed segment ab (to a when b == a).
+inline double point_segment_distance2(const Vec3d& p, const Vec3d& a, const Vec3d& b) {
+  const Vec3d ab = b - a, ap = p - a;
+  const double len2 = dot(ab, ab);
+  const double t = len2 > 0 ? std::clamp(dot(ap, ab) / len2, 0.0, 1.0) : 0.0;
+  const Vec3d r = ap - ab * t;
+  return dot(r, r);
+}
 
 struct Vec2d {
   double x = 0, y = 0;
@@ -60,6 +75,14 @@ struct Vec2d {
 };
 
 inline double cross2(const Vec2d& a, const Vec2d& b) { return a.x * b.y - a.y * b.x; }
+// The distance from p to the closed segment ab (to a when b == a).
+inline double point_segment_distance(const Vec2d& p, const Vec2d& a, const Vec2d& b) {
+  const Vec2d ab = b - a, ap = p - a;
+  const double len2 = ab.x * ab.x + ab.y * ab.y;
+  const double t = len2 > 0 ? std::clamp((ap.x * ab.x + ap.y * ab.y) / len2, 0.0, 1.0) : 0.0;
+  const Vec2d r = ap - ab * t;
+  return std::hypot(r.x, r.y);
+}
 // Shoelace area of a closed polygon (the last point is not repeated): positive when counter-clockwise.
 double signed_area(const std::vector<Vec2d>& polygon);
 // Whether the closed segments ab and cd share a point (exact orientation signs of the double inputs).

@@ -576,6 +576,29 @@ TEST(Simplify, PointTriangleDistanceHasItsClosedForms) {
   EXPECT_NEAR(point_triangle_distance({3, 0, 4}, a, b, {0.5, 0, 0}), std::sqrt(4.0 + 16), 1e-15);
 }
 
+// The shared helpers of geometry.h that the merge, the check, the layers and the fill rely on:
+// distances to a segment (each Voronoi region of it, and a segment that is a point) on 3-4-5
+// triangles, exact in floating point, and the dominant axis with its ties going to the lower axis.
+TEST(Geometry, SegmentDistancesAndDominantAxisHaveTheirClosedForms) {
+  const Vec3d a{0, 0, 0}, b{2, 0, 0};
+  EXPECT_EQ(point_segment_distance2({1, 3, 4}, a, b), 25);     // beside the segment
+  EXPECT_EQ(point_segment_distance2({-3, 0, 4}, a, b), 25);    // past a
+  EXPECT_EQ(point_segment_distance2({5, 4, 0}, a, b), 25);     // past b
+  EXPECT_EQ(point_segment_distance2({5, 4, 0}, b, a), 25);     // either way round
+  EXPECT_EQ(point_segment_distance2({1, 4, 5}, {1, 1, 1}, {1, 1, 1}), 25);  // a point
+  const Vec2d u{0, 0}, v{0, 2};
+  EXPECT_EQ(point_segment_distance(Vec2d{3, 1}, u, v), 3);
+  EXPECT_EQ(point_segment_distance(Vec2d{3, -4}, u, v), 5);
+  EXPECT_EQ(point_segment_distance(Vec2d{4, 5}, u, v), 5);
+  EXPECT_EQ(point_segment_distance(Vec2d{4, 5}, Vec2d{1, 1}, Vec2d{1, 1}), 5);
+  EXPECT_EQ(dominant_axis({1, 0, 0}), 0);
+  EXPECT_EQ(dominant_axis({0, -2, 1}), 1);
+  EXPECT_EQ(dominant_axis({0.5, 0.5, -3}), 2);
+  EXPECT_EQ(dominant_axis({1, -1, 0}), 0);
+  EXPECT_EQ(dominant_axis({0, 2, -2}), 1);
+  EXPECT_EQ(dominant_axis({-1, 1, 1}), 0);
+}
+
 // squared_limit(d) is the largest double whose rounded root is at most d, so comparing a squared
 // distance with it decides as comparing the distance with d (the simplifier relies on this to give
 // the same surface either way).

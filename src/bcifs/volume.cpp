@@ -649,9 +649,7 @@ namespace {
 std::vector<std::array<size_t, 3>> ear_clip(const std::vector<Vec3d>& polygon) {
   const Vec3d n = newell(polygon);
   // Drop the axis the normal is largest along; orient so the polygon is counter-clockwise in 2D.
-  const int axis = std::fabs(n.x) >= std::fabs(n.y) && std::fabs(n.x) >= std::fabs(n.z) ? 0
-                   : std::fabs(n.y) >= std::fabs(n.z)                                    ? 1
-                                                                                         : 2;
+  const int axis = dominant_axis(n);
   const int u = (axis + 1) % 3, v = (axis + 2) % 3;
   const double sign = n[axis] >= 0 ? 1 : -1;
   std::vector<Vec2d> p;

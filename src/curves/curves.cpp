@@ -455,11 +455,7 @@ bool TubeFootprint::covers(const Vec3d& p) const {
   for (uint32_t s : buckets_[(size_t(cell_of(p.x, 0)) * size_t(dims_[1]) + size_t(cell_of(p.y, 1))) * size_t(dims_[2]) +
                              size_t(cell_of(p.z, 2))]) {
     const auto& [a, b] = segments_[s];
-    const Vec3d ab = b - a;
-    const double len2 = dot(ab, ab);
-    const double t = len2 > 0 ? std::clamp(dot(p - a, ab) / len2, 0.0, 1.0) : 0.0;
-    const Vec3d q = a + ab * t - p;
-    if (dot(q, q) <= r2) return true;
+    if (point_segment_distance2(p, a, b) <= r2) return true;
   }
   return false;
 }

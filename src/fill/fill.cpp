@@ -217,13 +217,6 @@ bool point_in_polygon(const std::vector<Vec2d>& poly, const Vec2d& p) {
   return inside;
 }
 
-double point_segment_distance(const Vec2d& p, const Vec2d& a, const Vec2d& b) {
-  const Vec2d ab = b - a, ap = p - a;
-  const double l2 = dot2(ab, ab);
-  const double t = l2 > 0 ? std::clamp(dot2(ap, ab) / l2, 0.0, 1.0) : 0.0;
-  return length2(ap - ab * t);
-}
-
 double outline_distance(const std::vector<Vec2d>& poly, const Vec2d& p) {
   double d = HUGE_VAL;
   for (size_t i = 0, n = poly.size(); i < n; ++i) d = std::min(d, point_segment_distance(p, poly[i], poly[(i + 1) % n]));

@@ -37,7 +37,6 @@ Shape2 place(const Motif2& motif, const Placement2& placement);
 
 // Crossing-number test (either orientation); points on the outline go either way.
 bool point_in_polygon(const std::vector<Vec2d>& polygon, const Vec2d& p);
-double point_segment_distance(const Vec2d& p, const Vec2d& a, const Vec2d& b);
 // The distance from p to the outline of the polygon.
 double outline_distance(const std::vector<Vec2d>& polygon, const Vec2d& p);
 // Whether some edge of one polygon meets some edge of the other.

@@ -53,15 +53,6 @@ int orientation(const Vec2d& a, const Vec2d& b, const Vec2d& c) {
   return 0;
 }
 
-double segment_distance(const Vec2d& p, const Vec2d& a, const Vec2d& b) {
-  const Vec2d ab = b - a, ap = p - a;
-  const double len2 = ab.x * ab.x + ab.y * ab.y;
-  double t = len2 > 0 ? (ap.x * ab.x + ap.y * ab.y) / len2 : 0;
-  t = std::clamp(t, 0.0, 1.0);
-  const Vec2d q = a + ab * t;
-  return std::hypot(p.x - q.x, p.y - q.y);
-}
-
 // Whether closed segments ab and cd share a point (exact orientations).
 bool segments_meet(const Vec2d& a, const Vec2d& b, const Vec2d& c, const Vec2d& d) {
   const int o1 = orientation(a, b, c), o2 = orientation(a, b, d), o3 = orientation(c, d, a), o4 = orientation(c, d, b);
@@ -217,7 +208,7 @@ Contours simplify_contours(const Contours& contours, double tolerance_mm) {
       double worst = -1;
       size_t at = first;
       for (size_t k = first + 1; k < last; ++k) {
-        const double d = segment_distance(loop[k % n], a, b);
+        const double d = point_segment_distance(loop[k % n], a, b);
         if (d > worst) worst = d, at = k;
       }
       if (worst > tolerance_mm) {
