@@ -265,13 +265,16 @@ bool merged_triangles(const MergeInput& in, std::vector<std::array<uint8_t, 3>>&
     uint8_t loop[kMaxSlotsInLoop], faces[kMaxSlotsInLoop], at[kMaxSlotsInLoop];
     uint8_t removed[kMaxSlotsInLoop + 4];
     int k = 0, removed_count = 0;
-    double reach = 0;  // the farthest a left-out crossing lies from the segment between its neighbours
+    // The farthest a left-out crossing lies from the segment between its neighbours, squared (its
+    // root is taken once: the root is monotonic, so that is the largest root).
+    double reach2 = 0;
     for (int i = 0; i < patch.loop_length; ++i) {
       const int s = patch.loop[i];
       if (is_face_diagonal(s) && !((in.kept_faces >> face_of_diagonal(s)) & 1)) {
         removed[removed_count++] = uint8_t(s);
-        reach = std::max(reach, std::sqrt(point_segment_distance2(pos[s], pos[patch.loop[(i + patch.loop_length - 1) % patch.loop_length]],
-                                                                  pos[patch.loop[(i + 1) % patch.loop_length]])));
+        const Vec3d& before = pos[patch.loop[(i + patch.loop_length - 1) % patch.loop_length]];
+        const Vec3d& after = pos[patch.loop[(i + 1) % patch.loop_length]];
+        reach2 = std::max(reach2, point_segment_distance2(pos[s], before, after));
         continue;
       }
       at[k] = uint8_t(i);
@@ -379,7 +382,7 @@ bool merged_triangles(const MergeInput& in, std::vector<std::array<uint8_t, 3>>&
           lowest = std::min(lowest, height);
           highest = std::max(highest, height);
         }
-        flat = (highest - lowest) + reach <= 0.999 * dev;  // W + H
+        flat = (highest - lowest) + std::sqrt(reach2) <= 0.999 * dev;  // W + H
       }
       if (flat && !in.sampled_tests_only) {
         flat_axis = fk;

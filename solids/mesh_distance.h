@@ -39,7 +39,8 @@ inline double point_triangle_distance2(const Vec3d& p, const Vec3d& a, const Vec
     return norm2(p - (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)))));
   const double denominator = va + vb + vc;
   if (!(denominator > 0))  // degenerate: the nearest of its edges
-    return std::min({point_segment_distance2(p, a, b), point_segment_distance2(p, b, c), point_segment_distance2(p, c, a)});
+    return std::min(
+        {point_segment_distance2(p, a, b), point_segment_distance2(p, b, c), point_segment_distance2(p, c, a)});
   const double v = vb / denominator, w = vc / denominator;
   return norm2(p - (a + ab * v + ac * w));
 }
